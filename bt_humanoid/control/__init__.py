@@ -1,0 +1,1 @@
+"""Controllers: joint references, base driver, gripper. They know nothing about trees."""

@@ -1,0 +1,140 @@
+"""Drives the omnidirectional base to poses through its velocity actuators.
+
+A goal is a world-frame pose (x, y, yaw). Ruckig plans a straight,
+jerk-limited, phase-synchronised motion from the current commanded state to
+rest at the goal; each control step the base actuators get the planned
+velocity plus a proportional correction of the tracking error. A base that
+falls far behind its plan is blocked: the goal fails and the base brakes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from ruckig import Trajectory
+
+from bt_humanoid.control.motion import MotionHandle, plan_trajectory
+from bt_humanoid.sim.robot_config import BaseConfig
+from bt_humanoid.sim.robot_io import MujocoRobotIO
+
+POSITION_GAIN = 2.0  # 1/s: velocity correction per metre (radian) of tracking error
+BLOCKED_ERROR = 0.3  # m: a tracking error this large means something is in the way
+SETTLE_TIMEOUT = 2.0  # s after the plan ends before a goal that has not arrived fails
+
+
+def wrap_angle(angle: float) -> float:
+    """Angle in [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+class BaseDriver:
+    """Pose goals for the base, executed through velocity actuators."""
+
+    def __init__(self, io: MujocoRobotIO, config: BaseConfig) -> None:
+        self.io = io
+        self.config = config
+        self.actuators = np.array([io.actuator(config.joints[axis]) for axis in ("x", "y", "yaw")])
+        self.velocity = np.zeros(3)  # commanded (planned) velocity
+        self.acceleration = np.zeros(3)
+        self.reference = io.positions().copy()
+        self.handle: MotionHandle | None = None
+        self.trajectory: Trajectory | None = None
+        self.start = 0.0
+        self.target = self.reference.copy()
+        self.braking = False
+
+    def pose(self) -> np.ndarray:
+        """Odometry: (x, y, yaw) from the base joint encoders."""
+        return self.io.positions().copy()
+
+    def speeds(self) -> np.ndarray:
+        return self.io.velocities().copy()
+
+    def move_to(self, x: float, y: float, yaw: float, max_speed: float | None = None) -> MotionHandle:
+        """Start driving to a world pose; returns the handle to poll."""
+        if self.handle is not None:
+            self.handle.fail("pre-empted by a newer goal")
+        limits = self.config.limits
+        speed = min(max_speed or limits.max_speed, limits.max_speed)
+        start = self.reference.copy()
+        target = np.array([x, y, start[2] + wrap_angle(yaw - start[2])])
+        distance = float(np.hypot(*(target[:2] - start[:2])))
+        # per-axis limits shaped by the direction so the path stays straight and under the speed cap
+        direction = np.abs(target[:2] - start[:2]) / distance if distance > 1e-6 else np.array([0.7, 0.7])
+        direction = np.maximum(direction, 1e-3)
+        linear = (speed, limits.max_accel, limits.max_jerk)
+        angular = (limits.max_yaw_rate, limits.max_yaw_accel, limits.max_yaw_jerk)
+        plan_limits = tuple(np.array([lin * direction[0], lin * direction[1], ang]) for lin, ang in zip(linear, angular))
+        self.trajectory = plan_trajectory(start, self.velocity, self.acceleration, target, plan_limits, phase_sync=True)
+        self.start = self.io.time
+        self.target = target
+        self.braking = False
+        self.handle = MotionHandle(f"driving {distance:.2f} m", on_cancel=lambda _: self.brake())
+        return self.handle
+
+    def brake(self) -> None:
+        """Cancel the goal and decelerate to rest under the base limits."""
+        if self.handle is not None:
+            self.handle.fail("halted: braking")
+            self.handle = None
+        limits = self.config.limits
+        plan_limits = (
+            np.array([limits.max_speed, limits.max_speed, limits.max_yaw_rate]) * 1.5,
+            np.array([limits.max_accel, limits.max_accel, limits.max_yaw_accel]) * 2.0,
+            np.array([limits.max_jerk, limits.max_jerk, limits.max_yaw_jerk]) * 4.0,
+        )
+        self.reference = self.pose()
+        self.trajectory = plan_trajectory(
+            self.reference, self.velocity, self.acceleration, None, plan_limits, brake=True
+        )
+        self.start = self.io.time
+        self.braking = True
+
+    def step(self) -> None:
+        """Sample the plan, correct the tracking error, command the actuators."""
+        if self.trajectory is None:
+            self.io.command(self.actuators, np.zeros(3))
+            return
+        elapsed = self.io.time - self.start
+        position, velocity, acceleration = self.trajectory.at_time(min(elapsed, self.trajectory.duration))
+        self.reference = np.array(position)
+        self.velocity = np.array(velocity)
+        self.acceleration = np.array(acceleration)
+        if self.braking:
+            # velocity-only braking: no position correction, just ramp the command to zero
+            self.io.command(self.actuators, self.velocity)
+            if elapsed >= self.trajectory.duration:
+                self.trajectory, self.braking = None, False
+                self.velocity[:] = 0.0
+                self.acceleration[:] = 0.0
+            return
+        pose = self.pose()
+        error = self.reference - pose
+        error[2] = wrap_angle(error[2])
+        self.io.command(self.actuators, self.velocity + POSITION_GAIN * error)
+        self._check_progress(pose, elapsed)
+
+    def _check_progress(self, pose: np.ndarray, elapsed: float) -> None:
+        handle = self.handle
+        if handle is None:
+            return
+        tracking = float(np.hypot(*(self.reference[:2] - pose[:2])))
+        remaining = float(np.hypot(*(self.target[:2] - pose[:2])))
+        yaw_error = abs(wrap_angle(self.target[2] - pose[2]))
+        handle.feedback = f"{remaining:.2f} m to go, heading off by {math.degrees(yaw_error):.0f}°"
+        if tracking > BLOCKED_ERROR:
+            handle.fail(f"base blocked near ({pose[0]:.2f}, {pose[1]:.2f}): {tracking:.2f} m behind its plan")
+            self.handle = None
+            self.brake()
+            return
+        if elapsed < self.trajectory.duration:
+            return
+        tolerance = self.config.tolerance
+        if remaining < tolerance.position and math.degrees(yaw_error) < tolerance.yaw_deg:
+            handle.succeed(f"arrived within {remaining * 100:.1f} cm, {math.degrees(yaw_error):.1f}°")
+            self.handle = None
+        elif elapsed > self.trajectory.duration + SETTLE_TIMEOUT:
+            handle.fail(f"stopped {remaining:.2f} m and {math.degrees(yaw_error):.0f}° from the goal")
+            self.handle = None
+            self.brake()

@@ -1,0 +1,130 @@
+"""Joint position references for every position-controlled joint.
+
+One reference state (position, velocity, acceleration) per joint feeds the
+MuJoCo position actuators. Goals move subsets of joints along Ruckig
+trajectories; a new goal on a joint pre-empts the older one; braking brings
+every reference to rest under the joints' limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from ruckig import Trajectory
+
+from bt_humanoid.control.motion import MotionHandle, plan_trajectory
+from bt_humanoid.sim.robot_config import RobotConfig
+from bt_humanoid.sim.robot_io import MujocoRobotIO
+
+SETTLE_TOLERANCE = 0.03  # rad (or m for fingers): tracking error that counts as arrived
+SETTLE_TIMEOUT = 1.0  # s after the trajectory ends before a goal fails
+
+
+@dataclass
+class _Goal:
+    handle: MotionHandle
+    joints: np.ndarray  # indices into the controller's joint list
+    trajectory: Trajectory
+    start: float
+    target: np.ndarray | None  # None when braking
+    settle_check: bool = True
+    stall: dict = field(default_factory=dict)
+
+
+class JointReferenceController:
+    """Jerk-limited joint references for the arms, waist, head and fingers."""
+
+    def __init__(self, io: MujocoRobotIO, config: RobotConfig) -> None:
+        self.io = io
+        self.joints = io.joints
+        self.actuators = np.array([io.actuator(j) for j in self.joints])
+        self.limits = tuple(
+            np.array([getattr(config.motion_limits(j), kind) for j in self.joints])
+            for kind in ("velocity", "acceleration", "jerk")
+        )
+        self.position = io.positions().copy()
+        self.velocity = np.zeros(len(self.joints))
+        self.acceleration = np.zeros(len(self.joints))
+        self.goals: list[_Goal] = []
+
+    def indices(self, joints: list[str]) -> np.ndarray:
+        return np.array([self.io.index(j) for j in joints], dtype=int)
+
+    def move(self, targets: dict[str, float], speed_scale: float = 1.0, settle_check: bool = True) -> MotionHandle:
+        """Start moving ``targets`` (joint → position); returns the handle to poll."""
+        idx = self.indices(list(targets))
+        goal_q = np.clip(np.array(list(targets.values()), dtype=float), self.io.lower[idx], self.io.upper[idx])
+        handle = MotionHandle(f"moving {len(idx)} joints", on_cancel=self._cancelled)
+        self._preempt(idx, "pre-empted by a newer goal")
+        limits = tuple(limit[idx] * scale for limit, scale in zip(self.limits, (speed_scale, speed_scale, 1.0)))
+        trajectory = plan_trajectory(
+            self.position[idx], self.velocity[idx], self.acceleration[idx], goal_q, limits, phase_sync=False
+        )
+        self.goals.append(_Goal(handle, idx, trajectory, self.io.time, goal_q, settle_check))
+        return handle
+
+    def brake(self, joints: np.ndarray | None = None) -> None:
+        """Cancel goals and bring references (all, or ``joints``) to rest as fast as the limits allow."""
+        idx = np.arange(len(self.joints)) if joints is None else joints
+        self._preempt(idx, "halted: braking")
+        moving = idx[np.abs(self.velocity[idx]) + np.abs(self.acceleration[idx]) > 1e-9]
+        if len(moving) == 0:
+            return
+        trajectory = plan_trajectory(
+            self.position[moving],
+            self.velocity[moving],
+            self.acceleration[moving],
+            None,
+            tuple(limit[moving] for limit in self.limits),
+            brake=True,
+        )
+        self.goals.append(_Goal(MotionHandle("braking"), moving, trajectory, self.io.time, None, False))
+
+    def step(self) -> None:
+        """Advance every goal to the current time and command the actuators."""
+        now = self.io.time
+        measured = self.io.positions()
+        for goal in list(self.goals):
+            elapsed = now - goal.start
+            position, velocity, acceleration = goal.trajectory.at_time(min(elapsed, goal.trajectory.duration))
+            self.position[goal.joints] = position
+            self.velocity[goal.joints] = velocity
+            self.acceleration[goal.joints] = acceleration
+            if elapsed < goal.trajectory.duration:
+                goal.handle.feedback = f"{goal.handle.description}: {elapsed:.1f}/{goal.trajectory.duration:.1f} s"
+                continue
+            self.velocity[goal.joints] = 0.0
+            self.acceleration[goal.joints] = 0.0
+            self._finish(goal, measured, elapsed)
+        self.io.command(self.actuators, self.position)
+
+    def _finish(self, goal: _Goal, measured: np.ndarray, elapsed: float) -> None:
+        if goal.target is None or not goal.settle_check:
+            goal.handle.succeed("at rest" if goal.target is None else "reference reached")
+            self.goals.remove(goal)
+            return
+        error = np.abs(measured[goal.joints] - goal.target)
+        if np.all(error < SETTLE_TOLERANCE):
+            goal.handle.succeed("arrived")
+            self.goals.remove(goal)
+        elif elapsed > goal.trajectory.duration + SETTLE_TIMEOUT:
+            worst = int(np.argmax(error))
+            joint = self.joints[goal.joints[worst]]
+            goal.handle.fail(
+                f"joint {joint} stuck at {measured[goal.joints[worst]]:.3f} (target {goal.target[worst]:.3f}); blocked?"
+            )
+            self.goals.remove(goal)
+            self.brake(goal.joints)
+
+    def _preempt(self, idx: np.ndarray, reason: str) -> None:
+        for goal in list(self.goals):
+            if np.intersect1d(goal.joints, idx).size:
+                goal.handle.fail(reason)
+                self.goals.remove(goal)
+
+    def _cancelled(self, handle: MotionHandle) -> None:
+        for goal in list(self.goals):
+            if goal.handle is handle:
+                self.goals.remove(goal)
+                self.brake(goal.joints)

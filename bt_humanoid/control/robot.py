@@ -1,0 +1,50 @@
+"""The robot as skills see it: one object owning every controller.
+
+The executor calls ``step()`` at the control rate; skills send goals through
+``base``, ``joints`` and ``grippers`` and poll the returned handles;
+``brake()`` halts every motion so the robot comes to rest.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bt_humanoid.control.base_driver import BaseDriver
+from bt_humanoid.control.gripper import GripperController
+from bt_humanoid.control.joint_motion import JointReferenceController
+from bt_humanoid.sim.robot_config import RobotConfig
+from bt_humanoid.sim.robot_io import MujocoRobotIO
+from bt_humanoid.sim.simulation import Simulation
+
+REST_SPEED = 0.01  # m/s or rad/s: below this everywhere, the robot is at rest
+
+
+class RobotController:
+    """Base driver, joint references and grippers of one robot."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.config: RobotConfig = sim.robot
+        base_joints = [self.config.base.joints[axis] for axis in ("x", "y", "yaw")]
+        self.body_io = MujocoRobotIO(sim, self.config.actuated_joints)
+        self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)
+        self.joints = JointReferenceController(self.body_io, self.config)
+        self.grippers = GripperController(self.joints, self.config.grippers)
+
+    def step(self) -> None:
+        self.base.step()
+        self.joints.step()
+
+    def brake(self) -> None:
+        """Halt every motion: base and joints decelerate to rest under their limits."""
+        self.base.brake()
+        self.joints.brake()
+
+    def joint_positions(self) -> dict[str, float]:
+        return dict(zip(self.body_io.joints, self.body_io.positions().tolist()))
+
+    def max_speed(self) -> float:
+        """Fastest joint or base speed now (m/s or rad/s)."""
+        return float(max(np.max(np.abs(self.base.speeds())), np.max(np.abs(self.body_io.velocities()))))
+
+    def at_rest(self) -> bool:
+        return self.max_speed() < REST_SPEED

@@ -1,0 +1,41 @@
+"""Where robots/, worlds/, behaviors/ and missions/ live.
+
+They sit beside the package in the repository (an editable install), or
+wherever ``BT_HUMANOID_HOME`` points.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+
+def project_root() -> Path:
+    """The folder holding robots/, worlds/, behaviors/ and missions/."""
+    env = os.environ.get("BT_HUMANOID_HOME")
+    if env:
+        return Path(env).resolve()
+    return Path(__file__).resolve().parent.parent
+
+
+def robots_dir() -> Path:
+    return project_root() / "robots"
+
+
+def worlds_dir() -> Path:
+    return project_root() / "worlds"
+
+
+def behaviors_dir() -> Path:
+    return project_root() / "behaviors"
+
+
+def missions_dir() -> Path:
+    return project_root() / "missions"
+
+
+def available(folder: Path, marker: str) -> list[str]:
+    """Names of the subfolders of ``folder`` that contain ``marker``."""
+    if not folder.is_dir():
+        return []
+    return sorted(p.name for p in folder.iterdir() if (p / marker).is_file())

@@ -1,0 +1,1 @@
+"""MuJoCo world assembly, stepping, cameras and ground truth."""

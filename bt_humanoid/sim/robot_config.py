@@ -1,0 +1,119 @@
+"""robot.yaml: what a robot is made of and what its controllers may do."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field
+
+from bt_humanoid.errors import UserError, did_you_mean
+from bt_humanoid.paths import available, robots_dir
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class RobotParts(_Strict):
+    lower_body: str
+    upper_body: str
+    mount_site: str = "mount"
+
+
+class BaseLimits(_Strict):
+    max_speed: float = 0.8
+    max_accel: float = 0.8
+    max_jerk: float = 3.0
+    max_yaw_rate: float = 1.2
+    max_yaw_accel: float = 2.0
+    max_yaw_jerk: float = 8.0
+
+
+class BaseTolerance(_Strict):
+    position: float = 0.02
+    yaw_deg: float = 2.0
+
+
+class BaseConfig(_Strict):
+    joints: dict[str, str]
+    actuators: dict[str, str]
+    footprint_radius: float = 0.3
+    limits: BaseLimits = BaseLimits()
+    tolerance: BaseTolerance = BaseTolerance()
+
+
+class GripperConfig(_Strict):
+    joints: list[str]
+    open: float
+    closed: float
+    grip_site: str
+
+
+class CameraConfig(_Strict):
+    width: int = 320
+    height: int = 240
+    depth: bool = True
+    rate_hz: float = 10.0
+
+
+class MotionLimits(_Strict):
+    velocity: float
+    acceleration: float
+    jerk: float
+
+
+class SafetyDefaults(_Strict):
+    max_base_speed: float = 0.8
+    joint_limit_margin: float = 0.01
+    time_budget: float = 600.0
+
+
+class RecoveryDefaults(_Strict):
+    retries: int = 0
+    backoff: float = 0.5
+
+
+class RobotConfig(_Strict):
+    name: str
+    description: str = ""
+    parts: RobotParts
+    base: BaseConfig
+    groups: dict[str, list[str]]
+    grippers: dict[str, GripperConfig]
+    frames: dict[str, tuple[str, str]]
+    cameras: dict[str, CameraConfig] = Field(default_factory=dict)
+    joint_limits: dict[str, MotionLimits]
+    postures: dict[str, dict[str, float]]
+    safety: SafetyDefaults = SafetyDefaults()
+    recovery: RecoveryDefaults = RecoveryDefaults()
+    folder: Path = Path()
+
+    def motion_limits(self, joint: str) -> MotionLimits:
+        """Velocity/acceleration/jerk limits of one joint: its own, its group's, or the default."""
+        if joint in self.joint_limits:
+            return self.joint_limits[joint]
+        for group, joints in self.groups.items():
+            if joint in joints and group in self.joint_limits:
+                return self.joint_limits[group]
+        if any(joint in g.joints for g in self.grippers.values()) and "grippers" in self.joint_limits:
+            return self.joint_limits["grippers"]
+        return self.joint_limits["default"]
+
+    @property
+    def actuated_joints(self) -> list[str]:
+        """Every position-controlled joint: groups first, then gripper fingers."""
+        joints = [j for group in self.groups.values() for j in group]
+        joints += [j for g in self.grippers.values() for j in g.joints]
+        return joints
+
+
+def load_robot_config(name: str) -> RobotConfig:
+    """Read robots/<name>/robot.yaml; unknown names get the list of valid ones."""
+    folder = robots_dir() / name
+    path = folder / "robot.yaml"
+    if not path.is_file():
+        raise UserError(f"unknown robot '{name}'", hint=did_you_mean(name, available(robots_dir(), "robot.yaml")))
+    data = yaml.safe_load(path.read_text())
+    config = RobotConfig.model_validate({**data, "folder": folder})
+    return config

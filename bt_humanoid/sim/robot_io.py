@@ -1,0 +1,46 @@
+"""The robot's interface to its body: encoders in, actuator commands out.
+
+Controllers see only this: joint positions and velocities by name (what the
+encoders report) and actuator commands. They never touch the simulator's
+state directly, so the same controllers could drive other hardware.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bt_humanoid.sim.simulation import Simulation
+
+
+class MujocoRobotIO:
+    """Encoder reads and actuator writes for one robot in a Simulation."""
+
+    def __init__(self, sim: Simulation, joints: list[str]) -> None:
+        self.sim = sim
+        model = sim.model
+        self.joints = list(joints)
+        self._qpos = np.array([model.joint(j).qposadr[0] for j in joints])
+        self._qvel = np.array([model.joint(j).dofadr[0] for j in joints])
+        self._index = {j: i for i, j in enumerate(joints)}
+        self.lower = np.array([model.jnt_range[model.joint(j).id][0] for j in joints])
+        self.upper = np.array([model.jnt_range[model.joint(j).id][1] for j in joints])
+        self.limited = np.array([bool(model.jnt_limited[model.joint(j).id]) for j in joints])
+
+    def index(self, joint: str) -> int:
+        return self._index[joint]
+
+    def positions(self) -> np.ndarray:
+        return self.sim.data.qpos[self._qpos]
+
+    def velocities(self) -> np.ndarray:
+        return self.sim.data.qvel[self._qvel]
+
+    def actuator(self, joint: str) -> int:
+        return self.sim.actuator_for_joint(joint)
+
+    def command(self, actuators: np.ndarray, values: np.ndarray) -> None:
+        self.sim.data.ctrl[actuators] = values
+
+    @property
+    def time(self) -> float:
+        return self.sim.time

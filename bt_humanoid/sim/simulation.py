@@ -1,0 +1,72 @@
+"""The MuJoCo world: model, data, reset, stepping and name lookups.
+
+Ground-truth queries live in ground_truth.py; the robot's own view of itself
+(joint encoders, actuator commands) goes through robot_io.py.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+# Off-screen rendering without a display needs EGL; set before mujoco loads.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+from bt_humanoid.sim.assembly import world_spec  # noqa: E402
+from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config  # noqa: E402
+from bt_humanoid.sim.world_config import WorldConfig, load_world_config  # noqa: E402
+
+
+class Simulation:
+    """One robot in one world, stepped on simulation time."""
+
+    def __init__(self, world: WorldConfig, robot: RobotConfig) -> None:
+        self.world = world
+        self.robot = robot
+        self.spec = world_spec(world, robot)
+        self.model = self.spec.compile()
+        self.data = mujoco.MjData(self.model)
+        self.timestep = float(self.model.opt.timestep)
+        self.reset()
+
+    @classmethod
+    def load(cls, world: str, robot: str) -> Simulation:
+        return cls(load_world_config(world), load_robot_config(robot))
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    def reset(self, seed: int = 0) -> None:
+        """Initial state: robot at the world's start pose in its home posture, actuators holding it."""
+        mujoco.mj_resetData(self.model, self.data)
+        x, y, yaw_deg = self.world.robot_start
+        base = self.robot.base.joints
+        self.set_initial_joint(base["x"], x)
+        self.set_initial_joint(base["y"], y)
+        self.set_initial_joint(base["yaw"], math.radians(yaw_deg))
+        for joint, value in self.robot.postures.get("home", {}).items():
+            self.set_initial_joint(joint, value)
+        for joint in self.robot.actuated_joints:
+            actuator = self.actuator_for_joint(joint)
+            self.data.ctrl[actuator] = self.data.qpos[self.model.joint(joint).qposadr[0]]
+        self.rng = np.random.default_rng(seed)
+        mujoco.mj_forward(self.model, self.data)
+
+    def set_initial_joint(self, joint: str, value: float) -> None:
+        """Initial conditions only (reset and test set-up), never to move things."""
+        self.data.qpos[self.model.joint(joint).qposadr[0]] = value
+
+    def step(self, n: int = 1) -> None:
+        mujoco.mj_step(self.model, self.data, nstep=n)
+
+    def actuator_for_joint(self, joint: str) -> int:
+        """Index of the actuator that drives ``joint``."""
+        joint_id = self.model.joint(joint).id
+        for i in range(self.model.nu):
+            if self.model.actuator_trntype[i] == mujoco.mjtTrn.mjTRN_JOINT and self.model.actuator_trnid[i, 0] == joint_id:
+                return i
+        raise KeyError(f"no actuator drives joint '{joint}'")

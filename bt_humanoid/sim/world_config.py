@@ -1,0 +1,75 @@
+"""world.yaml: named places, surfaces, objects and people of a scene."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field
+
+from bt_humanoid.errors import UserError, did_you_mean
+from bt_humanoid.paths import available, worlds_dir
+
+Pose2D = tuple[float, float, float]  # x [m], y [m], yaw [deg]
+Region = tuple[tuple[float, float], tuple[float, float]]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class Place(_Strict):
+    pose: Pose2D
+    region: Region | None = None
+    kind: Literal["room", "furniture", "spot"] = "spot"
+
+
+class Surface(_Strict):
+    geom: str
+    place: str
+
+
+class WorldObject(_Strict):
+    body: str
+    kind: str
+    colour: str
+    upright: bool = False
+
+
+class Person(_Strict):
+    body: str
+    aliases: list[str] = Field(default_factory=list)
+
+
+class WorldConfig(_Strict):
+    name: str
+    description: str = ""
+    model: str
+    robot_start: Pose2D = (0.0, 0.0, 0.0)
+    bounds: Region
+    places: dict[str, Place]
+    surfaces: dict[str, Surface] = Field(default_factory=dict)
+    objects: dict[str, WorldObject] = Field(default_factory=dict)
+    people: dict[str, Person] = Field(default_factory=dict)
+    obstacles: list[str] = Field(default_factory=list)
+    folder: Path = Path()
+
+    @property
+    def model_path(self) -> Path:
+        return self.folder / self.model
+
+    def place(self, name: str) -> Place:
+        if name not in self.places:
+            raise UserError(f"unknown place '{name}' in world '{self.name}'", hint=did_you_mean(name, self.places))
+        return self.places[name]
+
+
+def load_world_config(name: str) -> WorldConfig:
+    """Read worlds/<name>/world.yaml; unknown names get the list of valid ones."""
+    folder = worlds_dir() / name
+    path = folder / "world.yaml"
+    if not path.is_file():
+        raise UserError(f"unknown world '{name}'", hint=did_you_mean(name, available(worlds_dir(), "world.yaml")))
+    data = yaml.safe_load(path.read_text())
+    return WorldConfig.model_validate({**data, "folder": folder})
