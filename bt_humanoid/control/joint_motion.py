@@ -55,7 +55,7 @@ class JointReferenceController:
         """Start moving ``targets`` (joint → position); returns the handle to poll."""
         idx = self.indices(list(targets))
         goal_q = np.clip(np.array(list(targets.values()), dtype=float), self.io.lower[idx], self.io.upper[idx])
-        handle = MotionHandle(f"moving {len(idx)} joints", on_cancel=self._cancelled)
+        handle = MotionHandle(f"moving {len(idx)} joint{'s' if len(idx) != 1 else ''}", on_cancel=self._cancelled)
         self._preempt(idx, "pre-empted by a newer goal")
         limits = tuple(limit[idx] * scale for limit, scale in zip(self.limits, (speed_scale, speed_scale, 1.0)))
         trajectory = plan_trajectory(

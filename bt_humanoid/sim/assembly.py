@@ -102,3 +102,13 @@ def _flatten_frames(parent: ET.Element) -> None:
             grandchild.set("pos", " ".join(f"{v:.9g}" for v in pos + frame_pos))
             grandchild.set("quat", " ".join(f"{v:.9g}" for v in quat))
             parent.insert(index + offset, grandchild)
+
+
+def joint_ranges(config: RobotConfig) -> dict[str, tuple[float, float]]:
+    """Position range of every limited joint of the robot, from its MJCF."""
+    model = robot_spec(config).compile()
+    return {
+        model.joint(i).name: (float(model.jnt_range[i][0]), float(model.jnt_range[i][1]))
+        for i in range(model.njnt)
+        if model.jnt_limited[i]
+    }

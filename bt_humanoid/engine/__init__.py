@@ -1,0 +1,1 @@
+"""Executor, safety/recovery decorators and the event log."""

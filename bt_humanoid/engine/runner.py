@@ -1,0 +1,136 @@
+"""One mission run, assembled: simulation, robot, skills, safety, compiled tree, executor, verdict."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from py_trees.common import Status
+
+from bt_humanoid.control.robot import RobotController
+from bt_humanoid.engine.events import EventLog
+from bt_humanoid.engine.executor import Executor
+from bt_humanoid.mission.compiler import CompiledMission, Compiler
+from bt_humanoid.mission.spec import MissionSpec
+from bt_humanoid.mission.success import ConditionResult, check_condition
+from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
+from bt_humanoid.sim.assembly import joint_ranges
+from bt_humanoid.sim.ground_truth import GroundTruth
+from bt_humanoid.sim.robot_config import load_robot_config
+from bt_humanoid.sim.simulation import Simulation
+from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.skills.context import Blackboard, SkillContext
+
+
+@dataclass
+class RunResult:
+    mission: str
+    tree_status: str
+    conditions: list[ConditionResult]
+    sim_time: float
+    wall_time: float
+    events: EventLog
+    said: list[str] = field(default_factory=list)
+    safety: str | None = None
+
+    @property
+    def success(self) -> bool:
+        return self.tree_status == "SUCCESS" and all(c.holds for c in self.conditions)
+
+    @property
+    def real_time_factor(self) -> float:
+        return self.sim_time / self.wall_time if self.wall_time > 0 else float("inf")
+
+    def summary(self) -> dict[str, Any]:
+        return {
+            "mission": self.mission,
+            "outcome": "success" if self.success else "failure",
+            "tree_status": self.tree_status,
+            "conditions": [{"condition": c.condition, "holds": c.holds, "detail": c.detail} for c in self.conditions],
+            "safety": self.safety,
+            "sim_time": round(self.sim_time, 3),
+            "wall_time": round(self.wall_time, 3),
+            "real_time_factor": round(self.real_time_factor, 2),
+        }
+
+
+@dataclass
+class MissionRun:
+    """Everything one run is made of; build it, optionally attach viewers, then ``execute()``."""
+
+    spec: MissionSpec
+    seed: int | None = None
+    tick_hz: float = 20.0
+    control_hz: float = 100.0
+    speak: Callable[[str], None] | None = None
+
+    def __post_init__(self) -> None:
+        header = self.spec.header
+        robot_config = load_robot_config(header.robot)
+        world = load_world_config(header.world)
+        self.sim = Simulation(world, robot_config)
+        self.sim.reset(self.seed if self.seed is not None else header.seed)
+        self.robot = RobotController(self.sim)
+        self.truth = GroundTruth(self.sim)
+        self.said: list[str] = []
+        safety = header.safety
+        defaults = robot_config.safety
+
+        def say(text: str) -> None:
+            self.said.append(text)
+            self.events.add(self.sim.time, "say", text=text)
+            if self.speak is not None:
+                self.speak(text)
+
+        self.events = EventLog()
+        self.context = SkillContext(
+            robot_config=robot_config,
+            world=world,
+            joint_ranges=joint_ranges(robot_config),
+            robot=self.robot,
+            clock=lambda: self.sim.time,
+            max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),
+            blackboard=Blackboard(header.blackboard),
+            speak=say,
+        )
+        self.stop_monitor = StopRequestMonitor()
+        self.time_budget = safety.time_budget or defaults.time_budget
+        margin = safety.joint_limit_margin if safety.joint_limit_margin is not None else defaults.joint_limit_margin
+        monitors = [
+            self.stop_monitor,
+            JointLimitMonitor(self.robot, margin),
+            TimeBudgetMonitor(self.time_budget, self.sim.time),
+        ]
+        self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time)
+        self.compiled: CompiledMission = Compiler(self.context, self.supervisor).compile(self.spec)
+        self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
+
+    def request_stop(self, reason: str = "stop requested") -> None:
+        self.stop_monitor.request(reason)
+
+    def execute(self) -> RunResult:
+        started = time.perf_counter()
+        status = self.executor.run(max_time=self.time_budget + 1.0)
+        wall = time.perf_counter() - started
+        conditions = [check_condition(c, self.truth) for c in self.spec.header.success]
+        violation = self.supervisor.violation
+        return RunResult(
+            mission=self.spec.header.mission,
+            tree_status=status.name if status is not Status.INVALID else "FAILURE",
+            conditions=conditions,
+            sim_time=self.sim.time,
+            wall_time=wall,
+            events=self.events,
+            said=self.said,
+            safety=f"{violation.monitor}: {violation.message}" if violation else None,
+        )
+
+
+def run_mission_file(path: Path, seed: int | None = None) -> RunResult:
+    """Load, compile and run a mission headless; the convenience entry for scripts and tests."""
+    from bt_humanoid.mission.loader import MissionLoader
+
+    return MissionRun(MissionLoader().load_file(path), seed=seed).execute()

@@ -1,0 +1,1 @@
+"""The mission language: schema, YAML loader with source positions, compiler."""

@@ -1,0 +1,277 @@
+"""Mission files → validated MissionSpecs, with every error at file:line.
+
+Validation happens in one pass over the YAML: each node's kind is looked up
+(composite, decorator, skill from the registry, behaviour from behaviors/),
+its body validated by that kind's pydantic model, and skill parameters
+checked against the robot and the world. The first problem found is raised
+as a UserError naming the place and what would be valid.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+
+from bt_humanoid.errors import UserError, did_you_mean
+from bt_humanoid.mission.behaviors import BehaviorLibrary, substitute
+from bt_humanoid.mission.schema import (
+    COMPOSITES,
+    CONDITION_KINDS,
+    LOADER_BODIES,
+    NODE_EXTRAS,
+    MissionHeader,
+    RecoverySettings,
+    structural_kinds,
+)
+from bt_humanoid.mission.spec import MissionSpec, NodeSpec
+from bt_humanoid.mission.yaml_source import YamlPath, YamlSource, display_path, read_yaml
+from bt_humanoid.sim.assembly import joint_ranges
+from bt_humanoid.sim.robot_config import load_robot_config
+from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.skills import REGISTRY
+from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.params import is_reference
+
+MAX_SUBTREE_DEPTH = 32
+
+
+def _first_error(error: ValidationError, source: YamlSource, base: YamlPath, prefix: str = "") -> UserError:
+    """The first pydantic error, positioned in the YAML and phrased for people."""
+    first = error.errors()[0]
+    loc = tuple(first["loc"])
+    field = ".".join(str(part) for part in loc)
+    kind = first["type"]
+    if kind == "missing":
+        message = f"missing required parameter '{field}'"
+        position = (*base,)
+    elif kind == "extra_forbidden":
+        message = f"unknown parameter '{field}'"
+        position = (*base, *loc)
+    else:
+        got = first.get("input")
+        shown = f" (got {got!r})" if got is not None and not isinstance(got, dict | list) else ""
+        message = f"{field + ': ' if field else ''}{first['msg']}{shown}"
+        position = (*base, *loc)
+    return UserError(f"{prefix}{message}", where=source.where(position))
+
+
+def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: YamlPath, prefix: str) -> BaseModel:
+    """Validate a skill's parameters; ``"$key"`` blackboard references are checked when the leaf starts."""
+    if raw is None:
+        raw = {}
+    if not isinstance(raw, dict):
+        raise UserError(f"{prefix}parameters must be a mapping, got {type(raw).__name__}", where=source.where(path))
+    references = {key for key, value in raw.items() if is_reference(value)}
+    concrete = {key: value for key, value in raw.items() if key not in references}
+    try:
+        return model.model_validate(concrete)
+    except ValidationError as error:
+        remaining = [e for e in error.errors() if not (e["loc"] and e["loc"][0] in references)]
+        if not remaining:
+            return model.model_construct(**concrete)
+        first_only = ValidationError.from_exception_data(error.title, [remaining[0]])  # type: ignore[list-item]
+        raise _first_error(first_only, source, path, prefix) from None
+
+
+class MissionLoader:
+    """Loads missions against the skill registry, a behaviour library and the named robot and world."""
+
+    def __init__(self, library: BehaviorLibrary | None = None) -> None:
+        self.library = library or BehaviorLibrary()
+
+    # --- entry points ------------------------------------------------------------
+
+    def load_file(self, file: Path) -> MissionSpec:
+        return self.load_source(read_yaml(Path(file)))
+
+    def load_text(self, text: str, name: str = "<mission>") -> MissionSpec:
+        return self.load_source(read_yaml(Path(name), text))
+
+    def load_data(self, data: dict[str, Any], name: str = "<plan>") -> MissionSpec:
+        """A mission given as data (a planner's output): errors name the plan step instead of a line."""
+        return self.load_source(YamlSource(Path(name), data))
+
+    def load_source(self, source: YamlSource) -> MissionSpec:
+        data = source.data
+        if not isinstance(data, dict):
+            raise UserError("a mission is a mapping with mission, tree and optional sections", where=source.where(()))
+        if "tree" not in data:
+            raise UserError("missing required section 'tree'", where=source.where(()))
+        header_data = {k: v for k, v in data.items() if k != "tree"}
+        try:
+            header = MissionHeader.model_validate(header_data)
+        except ValidationError as error:
+            raise _first_error(error, source, ()) from None
+        robot = load_robot_config_at(header.robot, source)
+        world = load_world_config_at(header.world, source)
+        self.checks = CheckContext(robot, world, joint_ranges(robot))
+        self._check_success(header, source)
+        self._check_recovery(header, source)
+        tree = self._node(data["tree"], source, ("tree",), "tree", stack=())
+        return MissionSpec(header, tree, source.file)
+
+    # --- nodes ----------------------------------------------------------------------
+
+    def _node(self, raw: Any, source: YamlSource, ypath: YamlPath, path: str, stack: tuple[str, ...]) -> NodeSpec:
+        where = source.where(ypath)
+        if not isinstance(raw, dict) or not raw:
+            raise UserError(
+                f"a tree node is a mapping with one kind key (a composite, decorator, skill or behaviour), "
+                f"got {type(raw).__name__ if raw is not None else 'nothing'}",
+                where=where,
+            )
+        kinds = [key for key in raw if key not in NODE_EXTRAS]
+        if len(kinds) != 1:
+            found = ", ".join(map(str, kinds)) or "none"
+            raise UserError(
+                f"a tree node needs exactly one kind key, found: {found} (besides optional {', '.join(NODE_EXTRAS)})",
+                where=where,
+            )
+        kind = str(kinds[0])
+        body = raw[kind]
+        bpath = (*ypath, kind)
+        node_path = kind if path == "tree" else (path + kind if path.endswith(">") else f"{path}.{kind}")
+        name = raw.get("name")
+        if name is not None and not isinstance(name, str):
+            raise UserError("name must be a string", where=source.where((*ypath, "name")))
+        recovery = None
+        if "recovery" in raw:
+            try:
+                recovery = RecoverySettings.model_validate(raw["recovery"])
+            except ValidationError as error:
+                raise _first_error(error, source, (*ypath, "recovery")) from None
+
+        def spec(**kw: Any) -> NodeSpec:
+            return NodeSpec(kind=kind, path=node_path, where=source.where(bpath), name=name, recovery=recovery, **kw)
+
+        if kind in COMPOSITES:
+            if not isinstance(body, list) or not body:
+                raise UserError(f"{kind} takes a non-empty list of child nodes", where=source.where(bpath))
+            children = [
+                self._node(child, source, (*bpath, i), f"{node_path}[{i}]", stack) for i, child in enumerate(body)
+            ]
+            return spec(category="composite", children=children)
+        if kind in LOADER_BODIES:
+            return self._decorator(kind, body, source, bpath, node_path, stack, spec)
+        if kind in REGISTRY:
+            return self._skill(kind, body, source, bpath, node_path, spec)
+        if kind in self.library.behaviors:
+            return self._behavior_call(kind, body, source, bpath, node_path, stack, spec)
+        options = [*structural_kinds(), *REGISTRY, *self.library.behaviors]
+        raise UserError(f"unknown skill or node kind '{kind}'", where=source.where(bpath), hint=did_you_mean(kind, options))
+
+    def _decorator(self, kind, body, source, bpath, node_path, stack, spec) -> NodeSpec:
+        model = LOADER_BODIES[kind]
+        if not isinstance(body, dict):
+            raise UserError(f"{kind} takes a mapping with {', '.join(model.model_fields)}", where=source.where(bpath))
+        try:
+            settings = model.model_validate(body)
+        except ValidationError as error:
+            raise _first_error(error, source, bpath, prefix=f"{kind}: ") from None
+        if kind == "subtree":
+            return self._subtree_file(settings, source, bpath, node_path, stack, spec)
+        children = []
+        if kind == "parallel":
+            children = [
+                self._node(child, source, (*bpath, "children", i), f"{node_path}[{i}]", stack)
+                for i, child in enumerate(body["children"])
+            ]
+        else:
+            if kind == "guard":
+                children.append(self._node(body["condition"], source, (*bpath, "condition"), f"{node_path}.condition", stack))
+            children.append(self._node(body["child"], source, (*bpath, "child"), node_path, stack))
+        return spec(category="decorator", settings=settings, children=children)
+
+    def _skill(self, kind, body, source, bpath, node_path, spec) -> NodeSpec:
+        info = REGISTRY[kind]
+        params = validate_params(info.params, body, source, bpath, prefix=f"{kind}: ")
+        raw = dict(body or {})
+        if not any(is_reference(v) for v in raw.values()):
+            for parameter, message in info.behaviour.check(params, self.checks):
+                raise UserError(f"{kind}: {message}", where=source.where((*bpath, parameter)))
+        return spec(category="skill", settings=params, raw=raw)
+
+    def _behavior_call(self, kind, body, source, bpath, node_path, stack, spec) -> NodeSpec:
+        behavior = self.library.behaviors[kind]
+        args_model = behavior.args_model
+        try:
+            args = args_model.model_validate(body or {})
+        except ValidationError as error:
+            raise _first_error(error, source, bpath, prefix=f"{kind}: ") from None
+        return self._expand(kind, behavior.source, args.model_dump(), source, bpath, node_path, stack, spec)
+
+    def _subtree_file(self, settings, source, bpath, node_path, stack, spec) -> NodeSpec:
+        file = (source.file.parent / settings.file).resolve()
+        if not file.is_file():
+            raise UserError(
+                f"subtree file not found: {display_path(file)}",
+                where=source.where((*bpath, "file")),
+                hint="paths are relative to the file that calls them",
+            )
+        from bt_humanoid.mission.behaviors import load_behavior
+
+        behavior = load_behavior(file)
+        try:
+            args = behavior.args_model.model_validate(settings.args)
+        except ValidationError as error:
+            raise _first_error(error, source, (*bpath, "args"), prefix=f"subtree {behavior.name}: ") from None
+        return self._expand(behavior.name, behavior.source, args.model_dump(), source, bpath, node_path, stack, spec)
+
+    def _expand(self, name, behavior_source, args, call_source, bpath, node_path, stack, spec) -> NodeSpec:
+        if name in stack:
+            chain = " → ".join([*stack, name])
+            raise UserError(f"recursive subtree: {chain}", where=call_source.where(bpath))
+        if len(stack) >= MAX_SUBTREE_DEPTH:
+            raise UserError(f"subtrees nested deeper than {MAX_SUBTREE_DEPTH}", where=call_source.where(bpath))
+        tree = substitute(behavior_source.data["tree"], args, behavior_source, ("tree",))
+        expanded = YamlSource(behavior_source.file, {"tree": tree}, behavior_source.lines)
+        root = self._node(tree, expanded, ("tree",), f"{node_path}>", (*stack, name))
+        return spec(category="behavior", children=[root])
+
+    # --- header checks against the world -------------------------------------------
+
+    def _check_success(self, header: MissionHeader, source: YamlSource) -> None:
+        world = self.checks.world
+        surfaces, objects, places = world.surfaces, world.objects, world.places
+        for i, condition in enumerate(header.success):
+            data = condition.model_dump()
+            kind = next(k for k in CONDITION_KINDS if k in data)
+            where = source.where(("success", i, kind))
+            names: list[tuple[str, dict]] = []
+            if kind == "on":
+                names = [(data["on"][0], objects), (data["on"][1], surfaces)]
+            elif kind == "at":
+                target = data["at"] if isinstance(data["at"], str) else data["at"]["place"]
+                names = [(target, places)]
+            elif kind in ("in_hand", "upright"):
+                names = [(data[kind], objects)]
+            for name, valid in names:
+                if name not in valid:
+                    raise UserError(f"success: unknown name '{name}'", where=where, hint=did_you_mean(name, valid))
+
+    def _check_recovery(self, header: MissionHeader, source: YamlSource) -> None:
+        for skill_name in header.recovery.skills:
+            if skill_name not in REGISTRY:
+                raise UserError(
+                    f"recovery: unknown skill '{skill_name}'",
+                    where=source.where(("recovery", "skills", skill_name)),
+                    hint=did_you_mean(skill_name, REGISTRY),
+                )
+
+
+def load_robot_config_at(name: str, source: YamlSource):
+    try:
+        return load_robot_config(name)
+    except UserError as error:
+        error.where = source.where(("robot",))
+        raise
+
+
+def load_world_config_at(name: str, source: YamlSource):
+    try:
+        return load_world_config(name)
+    except UserError as error:
+        error.where = source.where(("world",))
+        raise

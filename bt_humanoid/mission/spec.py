@@ -1,0 +1,45 @@
+"""The loaded, validated form of a mission: a header and a tree of NodeSpecs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel
+
+from bt_humanoid.mission.schema import MissionHeader, RecoverySettings
+
+Category = Literal["composite", "decorator", "skill", "behavior"]
+
+
+@dataclass
+class NodeSpec:
+    """One validated tree node.
+
+    ``path`` names the node the way it is written (``tree.sequence[2].move_base``)
+    and is how the event log and error messages refer to it; ``where`` is its
+    file:line.
+    """
+
+    kind: str
+    category: Category
+    path: str
+    where: str
+    settings: BaseModel | None = None  # decorator/parallel settings, or skill params (refs left out)
+    raw: dict[str, Any] = field(default_factory=dict)  # skill parameters as written ("$key" refs kept)
+    children: list[NodeSpec] = field(default_factory=list)
+    name: str | None = None
+    recovery: RecoverySettings | None = None
+
+    def walk(self):
+        yield self
+        for child in self.children:
+            yield from child.walk()
+
+
+@dataclass
+class MissionSpec:
+    header: MissionHeader
+    tree: NodeSpec
+    file: Path | None = None

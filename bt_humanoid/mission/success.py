@@ -1,0 +1,55 @@
+"""A mission's success: conditions checked against the simulator's ground truth at the end."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from bt_humanoid.control.base_driver import wrap_angle
+from bt_humanoid.mission.schema import (
+    AtCondition,
+    GripperCondition,
+    InHandCondition,
+    OnCondition,
+    SuccessCondition,
+    UprightCondition,
+)
+from bt_humanoid.sim.ground_truth import GroundTruth
+
+
+@dataclass(frozen=True)
+class ConditionResult:
+    condition: str
+    holds: bool
+    detail: str
+
+
+def check_condition(condition: SuccessCondition, truth: GroundTruth) -> ConditionResult:
+    if isinstance(condition, OnCondition):
+        obj, surface = condition.on
+        holds = truth.rests_on(obj, surface)
+        x, y, z = truth.object_position(obj)
+        return ConditionResult(f"{obj} on {surface}", holds, f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})")
+    if isinstance(condition, AtCondition):
+        target = condition.at
+        place, tolerance, yaw_tolerance = (target, 0.15, 15.0) if isinstance(target, str) else (
+            target.place, target.tolerance, target.yaw_tolerance)
+        px, py, pyaw = truth.sim.world.places[place].pose
+        x, y, yaw = truth.robot_pose()
+        distance = math.hypot(x - px, y - py)
+        heading = abs(math.degrees(wrap_angle(yaw - math.radians(pyaw))))
+        holds = distance <= tolerance and heading <= yaw_tolerance
+        return ConditionResult(f"robot at {place}", holds, f"{distance:.3f} m and {heading:.1f}° from its pose")
+    if isinstance(condition, InHandCondition):
+        side = truth.in_hand(condition.in_hand)
+        return ConditionResult(f"{condition.in_hand} in hand", side is not None, f"held by {side or 'no'} gripper")
+    if isinstance(condition, UprightCondition):
+        holds = truth.upright(condition.upright)
+        return ConditionResult(f"{condition.upright} upright", holds, "upright" if holds else "tipped over")
+    if isinstance(condition, GripperCondition):
+        side, state = condition.gripper
+        width = truth.gripper_width(side)
+        open_width = 2 * truth.sim.robot.grippers[side].open
+        holds = width > 0.9 * open_width if state == "open" else width < 0.5 * open_width
+        return ConditionResult(f"{side} gripper {state}", holds, f"jaws {width * 100:.1f} cm apart")
+    raise AssertionError(f"unhandled condition {condition!r}")

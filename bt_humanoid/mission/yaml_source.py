@@ -1,0 +1,85 @@
+"""YAML with positions: every value of a file keeps the line it came from."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from bt_humanoid.errors import UserError
+
+YamlPath = tuple[str | int, ...]
+
+
+def display_path(path: Path) -> str:
+    """A path as a user would type it: relative to the working directory when inside it."""
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return str(path)
+
+
+@dataclass
+class YamlSource:
+    """Parsed YAML data plus the line of every value (by path of keys and indices)."""
+
+    file: Path
+    data: Any
+    lines: dict[YamlPath, int] = field(default_factory=dict)
+
+    def where(self, path: YamlPath) -> str:
+        """'file:line' of the value at ``path``, or of its nearest ancestor."""
+        probe = tuple(path)
+        while probe and probe not in self.lines:
+            probe = probe[:-1]
+        line = self.lines.get(probe, 1)
+        return f"{display_path(self.file)}:{line}"
+
+
+def read_yaml(file: Path, text: str | None = None) -> YamlSource:
+    """Parse one YAML document; syntax errors become UserErrors at file:line."""
+    if text is None:
+        try:
+            text = file.read_text()
+        except FileNotFoundError:
+            raise UserError("file not found", where=display_path(file)) from None
+        except OSError as error:
+            raise UserError(f"cannot read: {error.strerror}", where=display_path(file)) from None
+    loader = yaml.SafeLoader(text)
+    try:
+        root = loader.get_single_node()
+        source = YamlSource(file, None)
+        source.data = _convert(loader, root, (), source) if root is not None else None
+        return source
+    except yaml.MarkedYAMLError as error:
+        mark = error.problem_mark or error.context_mark
+        line = mark.line + 1 if mark else 1
+        problem = error.problem or error.context or "invalid YAML"
+        raise UserError(f"YAML syntax error: {problem}", where=f"{display_path(file)}:{line}") from None
+    except yaml.YAMLError as error:
+        raise UserError(f"YAML error: {error}", where=display_path(file)) from None
+    finally:
+        loader.dispose()
+
+
+def _convert(loader: yaml.SafeLoader, node: yaml.Node, path: YamlPath, source: YamlSource) -> Any:
+    source.lines[path] = node.start_mark.line + 1
+    if isinstance(node, yaml.MappingNode):
+        result: dict[Any, Any] = {}
+        for key_node, value_node in node.value:
+            key = loader.construct_object(key_node, deep=True)
+            if not isinstance(key, str | int | float | bool) or key is None:
+                raise UserError("mapping keys must be plain names", where=f"{display_path(source.file)}:{key_node.start_mark.line + 1}")
+            if key in result:
+                line = key_node.start_mark.line + 1
+                raise UserError(f"duplicate key '{key}'", where=f"{display_path(source.file)}:{line}")
+            result[key] = _convert(loader, value_node, (*path, key), source)
+            # a key's own line wins over its value's (a block value starts on the next line)
+            source.lines[(*path, key)] = key_node.start_mark.line + 1
+        return result
+    if isinstance(node, yaml.SequenceNode):
+        return [_convert(loader, item, (*path, i), source) for i, item in enumerate(node.value)]
+    return loader.construct_object(node, deep=True)

@@ -1,0 +1,1 @@
+"""Safety monitors feeding the compiler's Safety guards."""

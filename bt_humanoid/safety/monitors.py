@@ -1,0 +1,99 @@
+"""Safety monitors, evaluated once per tick by the supervisor that every Safety guard reads.
+
+A monitor looks at the robot and the clock and returns a Violation or None.
+The first violation latches: every guard then halts its branch, the tree
+fails, and the executor brakes the robot to rest.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from bt_humanoid.control.robot import RobotController
+
+
+@dataclass(frozen=True)
+class Violation:
+    monitor: str
+    message: str
+    time: float
+
+
+class Monitor(Protocol):
+    name: str
+
+    def check(self, now: float) -> str | None:
+        """A message when the monitor fires, else None."""
+
+
+class StopRequestMonitor:
+    """Fires when someone asks the robot to stop (Ctrl-C, a typed or spoken "stop")."""
+
+    name = "stop"
+
+    def __init__(self) -> None:
+        self.reason: str | None = None
+
+    def request(self, reason: str = "stop requested") -> None:
+        self.reason = self.reason or reason
+
+    def check(self, now: float) -> str | None:
+        return self.reason
+
+
+class JointLimitMonitor:
+    """Fires when a joint is past its MJCF range by more than the margin."""
+
+    name = "joint_limits"
+
+    def __init__(self, robot: RobotController, margin: float) -> None:
+        io = robot.body_io
+        self.io = io
+        self.lower = np.where(io.limited, io.lower - margin, -np.inf)
+        self.upper = np.where(io.limited, io.upper + margin, np.inf)
+
+    def check(self, now: float) -> str | None:
+        q = self.io.positions()
+        bad = np.flatnonzero((q < self.lower) | (q > self.upper))
+        if bad.size == 0:
+            return None
+        i = int(bad[0])
+        return f"joint {self.io.joints[i]} at {q[i]:.3f} outside [{self.lower[i]:.3f}, {self.upper[i]:.3f}]"
+
+
+class TimeBudgetMonitor:
+    """Fires when the mission has used its simulation-time budget."""
+
+    name = "time_budget"
+
+    def __init__(self, budget: float, start: float = 0.0) -> None:
+        self.deadline = start + budget
+        self.budget = budget
+
+    def check(self, now: float) -> str | None:
+        if now > self.deadline:
+            return f"time budget of {self.budget:.0f} s used up"
+        return None
+
+
+class SafetySupervisor:
+    """Runs the monitors once per tick; the first violation latches."""
+
+    def __init__(self, monitors: list[Monitor], clock: Callable[[], float]) -> None:
+        self.monitors = monitors
+        self.clock = clock
+        self.violation: Violation | None = None
+
+    def update(self) -> Violation | None:
+        if self.violation is None:
+            now = self.clock()
+            for monitor in self.monitors:
+                message = monitor.check(now)
+                if message is not None:
+                    self.violation = Violation(monitor.name, message, now)
+                    break
+        return self.violation

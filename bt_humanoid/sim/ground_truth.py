@@ -1,0 +1,108 @@
+"""The simulator's answer key: object poses, contacts, what rests on what.
+
+Only tests, evaluation, success conditions and fault injection may use this;
+skills and planners read the robot's WorldModel instead.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from bt_humanoid.sim.simulation import Simulation
+
+UPRIGHT_TOLERANCE_DEG = 15.0
+RESTING_SPEED = 0.05  # m/s
+
+
+class GroundTruth:
+    def __init__(self, sim: Simulation) -> None:
+        self.sim = sim
+        self.model, self.data = sim.model, sim.data
+        robot_root = self.model.body("base").id
+        self.robot_bodies = {
+            i for i in range(self.model.nbody) if self._root_of(i) == robot_root
+        }
+
+    def _root_of(self, body: int) -> int:
+        while self.model.body_parentid[body] != 0:
+            body = self.model.body_parentid[body]
+        return body
+
+    def _object_body(self, name: str) -> int:
+        return self.model.body(self.sim.world.objects[name].body).id
+
+    def object_position(self, name: str) -> np.ndarray:
+        return self.data.xpos[self._object_body(name)].copy()
+
+    def object_speed(self, name: str) -> float:
+        body = self._object_body(name)
+        velocity = np.zeros(6)
+        mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, body, velocity, 0)
+        return float(np.linalg.norm(velocity[3:]))
+
+    def robot_pose(self) -> tuple[float, float, float]:
+        """(x, y, yaw in radians) of the base."""
+        joints = self.sim.robot.base.joints
+        qpos = self.data.qpos
+        return tuple(float(qpos[self.model.joint(joints[a]).qposadr[0]]) for a in ("x", "y", "yaw"))  # type: ignore[return-value]
+
+    def bodies_in_contact(self, body: int) -> set[int]:
+        """Bodies touching ``body`` now."""
+        touching = set()
+        for contact in self.data.contact[: self.data.ncon]:
+            b1, b2 = self.model.geom_bodyid[contact.geom1], self.model.geom_bodyid[contact.geom2]
+            if b1 == body:
+                touching.add(int(b2))
+            elif b2 == body:
+                touching.add(int(b1))
+        return touching
+
+    def geoms_in_contact(self, body: int) -> set[int]:
+        touching = set()
+        for contact in self.data.contact[: self.data.ncon]:
+            g1, g2 = contact.geom1, contact.geom2
+            if self.model.geom_bodyid[g1] == body:
+                touching.add(int(g2))
+            elif self.model.geom_bodyid[g2] == body:
+                touching.add(int(g1))
+        return touching
+
+    def rests_on(self, obj: str, surface: str) -> bool:
+        """The object touches the surface's top geom, lies above it and is (nearly) still."""
+        geom = self.model.geom(self.sim.world.surfaces[surface].geom).id
+        if geom not in self.geoms_in_contact(self._object_body(obj)):
+            return False
+        top = self.data.geom_xpos[geom][2] + self.model.geom_size[geom][2]
+        return bool(self.object_position(obj)[2] > top and self.object_speed(obj) < RESTING_SPEED)
+
+    def upright(self, obj: str) -> bool:
+        z_axis = self.data.xmat[self._object_body(obj)].reshape(3, 3)[:, 2]
+        return bool(math.degrees(math.acos(np.clip(z_axis[2], -1, 1))) < UPRIGHT_TOLERANCE_DEG)
+
+    def in_hand(self, obj: str) -> str | None:
+        """The side whose two finger pads both touch the object, else None."""
+        touching = self.geoms_in_contact(self._object_body(obj))
+        names = {self.model.geom(g).name for g in touching}
+        for side, prefix in (("left", "l"), ("right", "r")):
+            if {f"{prefix}_pad_a", f"{prefix}_pad_b"} <= names:
+                return side
+        return None
+
+    def gripper_width(self, side: str) -> float:
+        joints = self.sim.robot.grippers[side].joints
+        return float(sum(self.data.qpos[self.model.joint(j).qposadr[0]] for j in joints))
+
+    def robot_contacts(self) -> list[tuple[str, str]]:
+        """Contacts between the robot and anything else, as (robot geom, other geom) names."""
+        result = []
+        for contact in self.data.contact[: self.data.ncon]:
+            g1, g2 = contact.geom1, contact.geom2
+            in1 = self.model.geom_bodyid[g1] in self.robot_bodies
+            in2 = self.model.geom_bodyid[g2] in self.robot_bodies
+            if in1 != in2:
+                robot_geom, other = (g1, g2) if in1 else (g2, g1)
+                result.append((self.model.geom(robot_geom).name, self.model.geom(other).name))
+        return result

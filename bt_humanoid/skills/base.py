@@ -1,0 +1,84 @@
+"""Base class of every leaf skill: goals in initialise(), polling in update(), cancel in terminate()."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import py_trees
+from py_trees.common import Status
+from pydantic import BaseModel, ValidationError
+
+from bt_humanoid.control.motion import MotionHandle, MotionStatus
+from bt_humanoid.skills.context import CheckContext, SkillContext
+from bt_humanoid.skills.params import format_validation_error, resolve_references
+
+
+class Skill(py_trees.behaviour.Behaviour):
+    """A non-blocking leaf.
+
+    Subclasses define ``Params`` (a pydantic model), ``start()`` (send the goal,
+    may return a MotionHandle to poll) and optionally ``poll()`` and ``check()``.
+    Parameters may reference blackboard values as ``"$key"``; they are resolved
+    and validated when the leaf starts.
+    """
+
+    Params: ClassVar[type[BaseModel]]
+    skill_name: ClassVar[str] = ""
+
+    def __init__(self, name: str, raw_params: dict[str, Any], context: SkillContext, path: str) -> None:
+        super().__init__(name=name)
+        self.raw_params = raw_params
+        self.context = context
+        self.path = path
+        self.params: Any = None
+        self.motion: MotionHandle | None = None
+        self.error: str | None = None
+
+    @classmethod
+    def check(cls, params: BaseModel, context: CheckContext) -> list[tuple[str, str]]:
+        """Compile-time checks against the robot and world: (parameter, message) pairs."""
+        return []
+
+    def start(self) -> MotionHandle | None:
+        """Send the goal. Return a handle when there is a motion to poll."""
+        return None
+
+    def poll(self) -> Status:
+        """Progress of the goal; the default follows the motion handle."""
+        if self.motion is None:
+            return Status.SUCCESS
+        self.feedback_message = self.motion.feedback
+        if self.motion.status is MotionStatus.RUNNING:
+            return Status.RUNNING
+        self.feedback_message = self.motion.result
+        return Status.SUCCESS if self.motion.status is MotionStatus.SUCCEEDED else Status.FAILURE
+
+    # py_trees hooks -------------------------------------------------------
+
+    def initialise(self) -> None:
+        self.error, self.motion = None, None
+        try:
+            resolved = resolve_references(self.raw_params, self.context.blackboard)
+            self.params = self.Params.model_validate(resolved)
+        except KeyError as missing:
+            self.error = f"{self.path}: blackboard has no {missing.args[0]!r}"
+            return
+        except ValidationError as error:
+            self.error = f"{self.path}: {format_validation_error(error)}"
+            return
+        try:
+            self.motion = self.start()
+        except ValueError as error:
+            self.error = f"{self.path}: {error}"
+
+    def update(self) -> Status:
+        if self.error is not None:
+            self.feedback_message = self.error
+            return Status.FAILURE
+        return self.poll()
+
+    def terminate(self, new_status: Status) -> None:
+        # halted while running (pre-empted, stopped, timed out): brake what this leaf started
+        if new_status is Status.INVALID and self.motion is not None and not self.motion.done:
+            self.motion.cancel()
+            self.feedback_message = "halted"

@@ -1,0 +1,127 @@
+"""Skills that move the robot: base, joints, grippers."""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from bt_humanoid.control.motion import MotionHandle
+from bt_humanoid.errors import did_you_mean
+from bt_humanoid.skills.base import Skill
+from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.registry import skill
+
+
+class _Params(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class MoveBaseParams(_Params):
+    """Either a named place, or a pose (x, y, yaw) in the world or relative to the robot."""
+
+    place: str | None = Field(None, description="named place to drive to; yaw, if given, overrides its heading")
+    x: float | None = Field(None, ge=-100, le=100, description="metres; forward when relative")
+    y: float | None = Field(None, ge=-100, le=100, description="metres; left when relative")
+    yaw: float | None = Field(None, ge=-720, le=720, description="degrees; counter-clockwise; kept if omitted")
+    relative: bool = Field(False, description="x, y and yaw are relative to the robot's current pose")
+    max_speed: float | None = Field(None, gt=0, le=2.0, description="m/s cap, below the robot's and mission's limits")
+
+    @model_validator(mode="after")
+    def _place_or_pose(self) -> MoveBaseParams:
+        if self.place is not None and (self.x is not None or self.y is not None or self.relative):
+            raise ValueError("give either place or x/y, not both")
+        if self.place is None and not self.relative and (self.x is None or self.y is None):
+            raise ValueError("give a place, or both x and y (or relative: true)")
+        if self.place is None and self.relative and self.x is None and self.y is None and self.yaw is None:
+            raise ValueError("a relative move needs x, y or yaw")
+        return self
+
+
+@skill("move_base", "drive the base to a named place or a pose, world or relative, with smooth limited velocities")
+class MoveBase(Skill):
+    Params = MoveBaseParams
+
+    @classmethod
+    def check(cls, params: MoveBaseParams, context: CheckContext) -> list[tuple[str, str]]:
+        if params.place is not None and params.place not in context.world.places:
+            return [("place", f"unknown place '{params.place}' ({did_you_mean(params.place, context.world.places)})")]
+        return []
+
+    def start(self) -> MotionHandle:
+        p: MoveBaseParams = self.params
+        x0, y0, yaw0 = self.context.robot.base.pose()
+        if p.place is not None:
+            x, y, yaw_deg = self.context.world.place(p.place).pose
+            yaw = math.radians(p.yaw if p.yaw is not None else yaw_deg)
+        elif p.relative:
+            dx, dy = p.x or 0.0, p.y or 0.0
+            x = x0 + dx * math.cos(yaw0) - dy * math.sin(yaw0)
+            y = y0 + dx * math.sin(yaw0) + dy * math.cos(yaw0)
+            yaw = yaw0 + math.radians(p.yaw or 0.0)
+        else:
+            x, y = p.x, p.y
+            yaw = math.radians(p.yaw) if p.yaw is not None else yaw0
+        speed = min(s for s in (p.max_speed, self.context.max_base_speed) if s is not None)
+        return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
+
+
+class MoveJointsParams(_Params):
+    posture: str | None = Field(None, description="a named posture from robot.yaml")
+    joints: dict[str, float] | None = Field(None, description="joint name → position (rad, or m for fingers)")
+    speed: float = Field(1.0, gt=0, le=1.0, description="fraction of the joints' velocity and acceleration limits")
+
+    @model_validator(mode="after")
+    def _one_target(self) -> MoveJointsParams:
+        if (self.posture is None) == (self.joints is None):
+            raise ValueError("give exactly one of posture or joints")
+        return self
+
+
+@skill("move_joints", "move joints to a named posture or to joint positions along jerk-limited trajectories")
+class MoveJoints(Skill):
+    Params = MoveJointsParams
+
+    @classmethod
+    def check(cls, params: MoveJointsParams, context: CheckContext) -> list[tuple[str, str]]:
+        config = context.robot_config
+        if params.posture is not None and params.posture not in config.postures:
+            return [("posture", f"unknown posture '{params.posture}' ({did_you_mean(params.posture, config.postures)})")]
+        problems = []
+        for joint, value in (params.joints or {}).items():
+            if joint not in config.actuated_joints:
+                problems.append(("joints", f"unknown joint '{joint}' ({did_you_mean(joint, config.actuated_joints)})"))
+                continue
+            low, high = context.joint_ranges[joint]
+            if not low <= value <= high:
+                problems.append(("joints", f"{joint}={value} is outside its range [{low:.2f}, {high:.2f}]"))
+        return problems
+
+    def start(self) -> MotionHandle:
+        p: MoveJointsParams = self.params
+        targets = self.context.robot_config.postures[p.posture] if p.posture is not None else p.joints
+        return self.context.robot.joints.move(dict(targets), speed_scale=p.speed)
+
+
+class GripperParams(_Params):
+    action: Literal["open", "close"] = Field(description="open the jaws, or close until they stall on something")
+    side: Literal["left", "right"] = Field("right", description="which hand")
+
+
+@skill("gripper", "open a gripper, or close it until it holds something or shuts")
+class Gripper(Skill):
+    Params = GripperParams
+
+    def start(self) -> MotionHandle:
+        return self.context.robot.grippers.command(self.params.side, self.params.action)
+
+    def poll(self):
+        status = super().poll()
+        if self.motion is not None and self.motion.done and self.params.action == "close":
+            grippers = self.context.robot.grippers
+            held = grippers.holding(self.params.side)
+            self.feedback_message = (
+                f"holding something {grippers.width(self.params.side) * 100:.1f} cm wide" if held else "closed, empty"
+            )
+        return status
