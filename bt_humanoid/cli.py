@@ -1,0 +1,206 @@
+"""Command-line entry points: bt-run and bt-validate.
+
+Exit codes: 0 success, 1 mission failed, 2 invalid input. A user error is one
+line on stderr naming the place and what would be valid; never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+import time
+from pathlib import Path
+
+from rich.console import Console
+
+from bt_humanoid.errors import UserError
+from bt_humanoid.paths import missions_dir
+
+EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
+SCHEMA_FILE = "mission.schema.json"
+
+
+def _fail_invalid(error: UserError) -> int:
+    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {error}", markup=True, soft_wrap=True)
+    return EXIT_INVALID
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but bad usage exits 2 with a one-line message (argparse's own convention)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        self.exit(EXIT_INVALID, f"error: {message}\n")
+
+
+# --- bt-run -------------------------------------------------------------------------
+
+
+def _run_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="bt-run", description="Validate, compile and run a mission headless in MuJoCo.")
+    parser.add_argument("mission", type=Path, help="mission YAML file")
+    parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
+    parser.add_argument("--no-live", action="store_true", help="plain status lines instead of the live tree")
+    parser.add_argument("--summary-json", type=Path, help="write the run summary to this JSON file")
+    parser.add_argument("--events", type=Path, help="write the JSONL event log to this file")
+    parser.add_argument("--record", type=Path, help="write a video of the run (.mp4) from the scene camera")
+    parser.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
+    parser.add_argument("--tick-hz", type=float, default=20.0, help="tree tick rate in simulation time")
+    return parser
+
+
+def run_main(argv: list[str] | None = None) -> int:
+    args = _run_parser().parse_args(argv)
+    console = Console(soft_wrap=True)
+    try:
+        from bt_humanoid.engine.runner import MissionRun
+        from bt_humanoid.mission.loader import MissionLoader
+
+        if not 1.0 <= args.tick_hz <= 1000.0:
+            raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
+        spec = MissionLoader().load_file(args.mission)
+        run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz, speak=lambda text: None)
+        recorder = None
+        if args.record:
+            from bt_humanoid.viz.recorder import VideoRecorder
+
+            recorder = VideoRecorder(run.sim, args.record)
+            run.executor.observers.append(recorder.capture)
+    except UserError as error:
+        return _fail_invalid(error)
+
+    if args.realtime:
+        started = time.perf_counter()
+
+        def pace() -> None:
+            ahead = run.sim.time - (time.perf_counter() - started)
+            if ahead > 0:
+                time.sleep(ahead)
+
+        run.executor.observers.append(pace)
+
+    def on_interrupt(signum: int, frame: object) -> None:
+        if run.stop_monitor.reason is not None:
+            raise KeyboardInterrupt
+        run.request_stop("stop requested (Ctrl-C)")
+
+    previous = signal.signal(signal.SIGINT, on_interrupt)
+    live = not args.no_live and console.is_terminal
+    try:
+        if live:
+            from bt_humanoid.viz.live import LiveTreeView
+
+            with LiveTreeView(run.executor, console):
+                result = run.execute()
+        else:
+            from bt_humanoid.viz.live import print_event
+
+            console.print(f"mission: {spec.header.mission}  ({args.mission})", highlight=False)
+            run.events.listeners.append(lambda event: print_event(console, event))
+            result = run.execute()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if recorder is not None:
+            recorder.close()
+
+    _print_summary(console, result, args)
+    if args.summary_json:
+        args.summary_json.parent.mkdir(parents=True, exist_ok=True)
+        args.summary_json.write_text(json.dumps(result.summary(), indent=2) + "\n")
+    if args.events:
+        result.events.write(args.events)
+    return EXIT_OK if result.success else EXIT_FAILED
+
+
+def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
+    ok = result.success
+    verdict = "[bold green]SUCCESS[/]" if ok else "[bold red]FAILURE[/]"
+    console.print(f"\n{verdict}  {result.mission}")
+    console.print(f"  tree: {result.tree_status}", highlight=False)
+    if result.safety:
+        console.print(f"  safety stop: {result.safety}", highlight=False, markup=False)
+    for condition in result.conditions:
+        mark = "[green]✔[/]" if condition.holds else "[red]✘[/]"
+        console.print(f"  {mark} {condition.condition}: {condition.detail}", highlight=False)
+    console.print(
+        f"  sim time {result.sim_time:.2f} s, wall time {result.wall_time:.2f} s, "
+        f"real-time factor {result.real_time_factor:.1f}×",
+        highlight=False,
+    )
+    if args.record:
+        console.print(f"  video: {args.record}", highlight=False)
+
+
+# --- bt-validate ----------------------------------------------------------------------
+
+
+def _validate_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="bt-validate", description="Check missions and behaviours without running them.")
+    parser.add_argument("files", nargs="*", type=Path, help="mission or behaviour YAML files")
+    parser.add_argument(
+        "--schema", nargs="?", const="-", metavar="PATH", help="write the mission JSON Schema (to stdout with no PATH)"
+    )
+    return parser
+
+
+def mission_schema() -> dict:
+    from bt_humanoid.mission.behaviors import BehaviorLibrary
+    from bt_humanoid.mission.schema import json_schema
+
+    return json_schema(BehaviorLibrary().args_models())
+
+
+def validate_file(file: Path) -> str:
+    """Validate a mission or behaviour file; returns a one-line description, raises UserError."""
+    from bt_humanoid.mission.behaviors import load_behavior
+    from bt_humanoid.mission.loader import MissionLoader
+    from bt_humanoid.mission.yaml_source import read_yaml
+
+    source = read_yaml(file)
+    if isinstance(source.data, dict) and "behavior" in source.data:
+        behavior = load_behavior(file)
+        loader = MissionLoader(check_world=False)
+        # a behaviour's tree is checked by expanding it in a throw-away mission with its defaults
+        loader.load_data({"mission": f"check {behavior.name}", "tree": {behavior.name: _default_args(behavior)}}, str(file))
+        return f"behaviour '{behavior.name}'"
+    spec = MissionLoader().load_source(source)
+    count = sum(1 for _ in spec.tree.walk())
+    return f"mission '{spec.header.mission}' ({count} nodes)"
+
+
+def _default_args(behavior) -> dict:
+    """Arguments that satisfy a behaviour's required parameters, for checking its tree on its own."""
+    samples = {str: "x", float: 0.0, int: 0, bool: False}
+    args = {}
+    for name, field in behavior.args_model.model_fields.items():
+        if field.is_required():
+            args[name] = samples.get(field.annotation, "x")
+    return args
+
+
+def validate_main(argv: list[str] | None = None) -> int:
+    args = _validate_parser().parse_args(argv)
+    console = Console(highlight=False, soft_wrap=True)
+    try:
+        if args.schema is not None:
+            text = json.dumps(mission_schema(), indent=2) + "\n"
+            if args.schema == "-":
+                sys.stdout.write(text)
+            else:
+                Path(args.schema).write_text(text)
+                console.print(f"wrote {args.schema}")
+            if not args.files:
+                return EXIT_OK
+        if not args.files:
+            raise UserError("no files given", hint=f"e.g. bt-validate {missions_dir().name}/*.yaml")
+        for file in args.files:
+            console.print(f"[green]ok[/] {file}: {validate_file(file)}")
+    except UserError as error:
+        return _fail_invalid(error)
+    return EXIT_OK
+
+
+if __name__ == "__main__":
+    sys.exit(run_main())

@@ -1,0 +1,1 @@
+"""Watching runs: the live terminal tree, plain status lines, video recording."""
