@@ -10,7 +10,7 @@ as a UserError naming the place and what would be valid.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, get_args
 
 from pydantic import BaseModel, ValidationError
 
@@ -23,6 +23,7 @@ from bt_humanoid.mission.schema import (
     NODE_EXTRAS,
     MissionHeader,
     RecoverySettings,
+    SuccessCondition,
     structural_kinds,
 )
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
@@ -102,6 +103,7 @@ class MissionLoader:
         if "tree" not in data:
             raise UserError("missing required section 'tree'", where=source.where(()))
         header_data = {k: v for k, v in data.items() if k != "tree"}
+        self._check_condition_kinds(header_data.get("success"), source)
         try:
             header = MissionHeader.model_validate(header_data)
         except ValidationError as error:
@@ -233,6 +235,27 @@ class MissionLoader:
         return spec(category="behavior", children=[root])
 
     # --- header checks against the world -------------------------------------------
+
+    def _check_condition_kinds(self, success: Any, source: YamlSource) -> None:
+        """Each success condition names one known kind; its fields are then checked by that kind's model."""
+        if success is None:
+            return
+        if not isinstance(success, list):
+            raise UserError("success: a list of conditions", where=source.where(("success",)))
+        for i, condition in enumerate(success):
+            kinds = list(condition) if isinstance(condition, dict) else []
+            if len(kinds) != 1 or kinds[0] not in CONDITION_KINDS:
+                shown = ", ".join(map(str, kinds)) or repr(condition)
+                raise UserError(
+                    f"success: unknown condition '{shown}'",
+                    where=source.where(("success", i)),
+                    hint=f"valid: {', '.join(CONDITION_KINDS)}",
+                )
+            model = next(m for m in get_args(SuccessCondition) if kinds[0] in m.model_fields)
+            try:
+                model.model_validate(condition)
+            except ValidationError as error:
+                raise _first_error(error, source, ("success", i), prefix="success: ") from None
 
     def _check_success(self, header: MissionHeader, source: YamlSource) -> None:
         world = self.checks.world

@@ -70,9 +70,11 @@ def _convert(loader: yaml.SafeLoader, node: yaml.Node, path: YamlPath, source: Y
     if isinstance(node, yaml.MappingNode):
         result: dict[Any, Any] = {}
         for key_node, value_node in node.value:
-            key = loader.construct_object(key_node, deep=True)
-            if not isinstance(key, str | int | float | bool) or key is None:
-                raise UserError("mapping keys must be plain names", where=f"{display_path(source.file)}:{key_node.start_mark.line + 1}")
+            if not isinstance(key_node, yaml.ScalarNode):
+                line = key_node.start_mark.line + 1
+                raise UserError("mapping keys must be plain names", where=f"{display_path(source.file)}:{line}")
+            # keys are names: keep them as written (YAML 1.1 would read `on:` or `yes:` as booleans)
+            key = key_node.value
             if key in result:
                 line = key_node.start_mark.line + 1
                 raise UserError(f"duplicate key '{key}'", where=f"{display_path(source.file)}:{line}")

@@ -1,0 +1,51 @@
+"""Run a mission headless for a test and keep everything needed to judge it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from bt_humanoid.engine.runner import MissionRun, RunResult
+from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.sim.ground_truth import GroundTruth
+
+
+@dataclass
+class Scenario:
+    """A finished run: its result, the run itself and the simulator's ground truth."""
+
+    run: MissionRun
+    result: RunResult
+
+    @property
+    def truth(self) -> GroundTruth:
+        return self.run.truth
+
+    @property
+    def events(self) -> list[dict[str, Any]]:
+        return self.result.events.events
+
+    def statuses(self, node: str) -> list[str]:
+        """The statuses one node went through, in order."""
+        return [e["new"] for e in self.events if e["event"] == "status" and e["node"] == node]
+
+    def final_speed(self) -> float:
+        return self.run.robot.max_speed()
+
+
+def build_run(mission: str | Path | dict, seed: int | None = None) -> MissionRun:
+    """A MissionRun from a file path, YAML text or a mission mapping (not yet executed)."""
+    loader = MissionLoader()
+    if isinstance(mission, dict):
+        spec = loader.load_data(mission)
+    elif isinstance(mission, Path) or (isinstance(mission, str) and mission.endswith(".yaml") and "\n" not in mission):
+        spec = loader.load_file(Path(mission))
+    else:
+        spec = loader.load_text(mission)
+    return MissionRun(spec, seed=seed)
+
+
+def run_scenario(mission: str | Path | dict, seed: int | None = None) -> Scenario:
+    run = build_run(mission, seed)
+    return Scenario(run, run.execute())
