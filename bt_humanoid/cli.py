@@ -163,7 +163,9 @@ def validate_file(file: Path) -> str:
         behavior = load_behavior(file)
         loader = MissionLoader(check_world=False)
         # a behaviour's tree is checked by expanding it in a throw-away mission with its defaults
-        loader.load_data({"mission": f"check {behavior.name}", "tree": {behavior.name: _default_args(behavior)}}, str(file))
+        loader.load_data(
+            {"mission": f"check {behavior.name}", "tree": {behavior.name: _default_args(behavior)}}, str(file)
+        )
         return f"behaviour '{behavior.name}'"
     spec = MissionLoader().load_source(source)
     count = sum(1 for _ in spec.tree.walk())

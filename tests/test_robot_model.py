@@ -45,7 +45,9 @@ def test_hand_positions_agree_for_random_postures(models, config):
                 q_pin[pin_model.joints[jid].idx_q] = q[mj_model.jnt_qposadr[j]]
         # the three base joints are one composite joint in Pinocchio
         composite = pin_model.joints[1]
-        q_pin[composite.idx_q : composite.idx_q + 3] = q[[mj_model.joint(n).qposadr[0] for n in ("base_x", "base_y", "base_yaw")]]
+        q_pin[composite.idx_q : composite.idx_q + 3] = q[
+            [mj_model.joint(n).qposadr[0] for n in ("base_x", "base_y", "base_yaw")]
+        ]
         pin.framesForwardKinematics(pin_model, pin_data, q_pin)
         for site in ("l_grip", "r_grip"):
             np.testing.assert_allclose(
@@ -61,7 +63,7 @@ def test_robot_yaml_names_exist_in_the_mjcf(models, config):
     assert len(config.groups["left_arm"]) == 7 and len(config.groups["right_arm"]) == 7
     for posture, targets in config.postures.items():
         assert set(targets) <= joints, posture
-    for name, (kind, mjcf_name) in config.frames.items():
+    for _name, (kind, mjcf_name) in config.frames.items():
         lookup = {"site": mj_model.site, "camera": mj_model.camera, "body": mj_model.body}[kind]
         lookup(mjcf_name)  # raises KeyError when missing
     for camera in config.cameras:

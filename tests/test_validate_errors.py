@@ -23,13 +23,17 @@ def validate(capsys, *files: Path) -> tuple[int, str]:
 
 
 def test_yaml_syntax_error(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: broken
         tree:
           sequence:
             - wait: {seconds: 1
             - say: {text: hi}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:5" in err or "m.yaml:4" in err
@@ -37,13 +41,17 @@ def test_yaml_syntax_error(tmp_path, capsys):
 
 
 def test_unknown_skill_suggests_the_closest(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: typo
         tree:
           sequence:
             - wait: {seconds: 1}
             - move_bse: {x: 1, y: 0}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:5" in err
@@ -52,72 +60,100 @@ def test_unknown_skill_suggests_the_closest(tmp_path, capsys):
 
 
 def test_wrong_parameter_type(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: types
         tree:
           sequence:
             - wait: {seconds: soon}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:4" in err and "seconds" in err and "'soon'" in err
 
 
 def test_missing_required_parameter(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: missing
         tree:
           sequence:
             - say: {}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:4" in err and "missing required parameter 'text'" in err
 
 
 def test_unknown_parameter_is_named(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: extra
         tree:
           wait:
             seconds: 1
             minutes: 2
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:5" in err and "unknown parameter 'minutes'" in err
 
 
 def test_missing_subtree_file(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: subtree
         tree:
           sequence:
             - subtree: {file: nowhere/pick.yaml}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:4" in err and "subtree file not found" in err and "pick.yaml" in err
 
 
 def test_recursive_subtree(tmp_path, capsys):
-    write(tmp_path, "a.yaml", """
+    write(
+        tmp_path,
+        "a.yaml",
+        """
         behavior: a
         tree:
           sequence:
             - wait: {seconds: 1}
             - subtree: {file: b.yaml}
-        """)
-    write(tmp_path, "b.yaml", """
+        """,
+    )
+    write(
+        tmp_path,
+        "b.yaml",
+        """
         behavior: b
         tree:
           subtree: {file: a.yaml}
-        """)
-    path = write(tmp_path, "m.yaml", """
+        """,
+    )
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: loops
         tree:
           subtree: {file: a.yaml}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "recursive subtree: a → b → a" in err
@@ -129,55 +165,75 @@ def test_recursive_subtree(tmp_path, capsys):
     [("world", "flat", "apartment"), ("robot", "wheeled_humanoidd", "did you mean 'wheeled_humanoid'")],
 )
 def test_unknown_world_or_robot(tmp_path, capsys, field, value, valid):
-    path = write(tmp_path, "m.yaml", f"""
+    path = write(
+        tmp_path,
+        "m.yaml",
+        f"""
         mission: where
         {field}: {value}
         tree:
           wait: {{seconds: 1}}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:2" in err and f"unknown {field} '{value}'" in err and valid in err
 
 
 def test_unknown_place_in_a_skill_and_in_success(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: places
         tree:
           move_base: {place: kitchn}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2 and "m.yaml:3" in err and "did you mean 'kitchen'" in err
-    path = write(tmp_path, "n.yaml", """
+    path = write(
+        tmp_path,
+        "n.yaml",
+        """
         mission: success names
         tree:
           wait: {seconds: 1}
         success:
           - on: [red cube, tabel]
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2 and "n.yaml:5" in err and "did you mean 'table'" in err
 
 
 def test_unknown_behaviour_parameter_in_a_call(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: args
         tree:
           approach: {place: table, sped: 0.2}
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2 and "m.yaml:3" in err and "unknown parameter 'sped'" in err
 
 
 def test_unknown_success_condition(tmp_path, capsys):
-    path = write(tmp_path, "m.yaml", """
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
         mission: conditions
         tree:
           wait: {seconds: 1}
         success:
           - at: table
           - under: [red cube, table]
-        """)
+        """,
+    )
     code, err = validate(capsys, path)
     assert code == 2 and "m.yaml:6" in err and "unknown condition 'under'" in err and "valid: on, at" in err
 

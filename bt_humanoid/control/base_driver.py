@@ -65,7 +65,9 @@ class BaseDriver:
         direction = np.maximum(direction, 1e-3)
         linear = (speed, limits.max_accel, limits.max_jerk)
         angular = (limits.max_yaw_rate, limits.max_yaw_accel, limits.max_yaw_jerk)
-        plan_limits = tuple(np.array([lin * direction[0], lin * direction[1], ang]) for lin, ang in zip(linear, angular))
+        plan_limits = tuple(
+            np.array([lin * direction[0], lin * direction[1], ang]) for lin, ang in zip(linear, angular, strict=False)
+        )
         self.trajectory = plan_trajectory(start, self.velocity, self.acceleration, target, plan_limits, phase_sync=True)
         self.start = self.io.time
         self.target = target

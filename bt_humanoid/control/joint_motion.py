@@ -57,7 +57,8 @@ class JointReferenceController:
         goal_q = np.clip(np.array(list(targets.values()), dtype=float), self.io.lower[idx], self.io.upper[idx])
         handle = MotionHandle(f"moving {len(idx)} joint{'s' if len(idx) != 1 else ''}", on_cancel=self._cancelled)
         self._preempt(idx, "pre-empted by a newer goal")
-        limits = tuple(limit[idx] * scale for limit, scale in zip(self.limits, (speed_scale, speed_scale, 1.0)))
+        scales = (speed_scale, speed_scale, 1.0)  # velocity and acceleration scale; jerk stays
+        limits = tuple(limit[idx] * scale for limit, scale in zip(self.limits, scales, strict=True))
         trajectory = plan_trajectory(
             self.position[idx], self.velocity[idx], self.acceleration[idx], goal_q, limits, phase_sync=False
         )

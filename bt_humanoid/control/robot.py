@@ -40,7 +40,7 @@ class RobotController:
         self.joints.brake()
 
     def joint_positions(self) -> dict[str, float]:
-        return dict(zip(self.body_io.joints, self.body_io.positions().tolist()))
+        return dict(zip(self.body_io.joints, self.body_io.positions().tolist(), strict=False))
 
     def max_speed(self) -> float:
         """Fastest joint or base speed now (m/s or rad/s)."""

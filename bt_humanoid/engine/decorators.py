@@ -51,8 +51,10 @@ class RecoveryPolicy(py_trees.decorators.Decorator):
         backoff: float,
         clock: Callable[[], float],
         supervisor: SafetySupervisor,
+        on_retry: Callable[[RecoveryPolicy], None] | None = None,
     ) -> None:
         super().__init__(name=name, child=child)
+        self.on_retry = on_retry
         self.retries = retries
         self.backoff = backoff
         self.clock = clock
@@ -89,6 +91,8 @@ class RecoveryPolicy(py_trees.decorators.Decorator):
         self.feedback_message = (
             f"retry {self.failures}/{self.retries} in {self.backoff:.1f} s after: {self.decorated.feedback_message}"
         )
+        if self.on_retry is not None:
+            self.on_retry(self)
         return Status.RUNNING
 
 

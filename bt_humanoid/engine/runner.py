@@ -105,7 +105,11 @@ class MissionRun:
             TimeBudgetMonitor(self.time_budget, self.sim.time),
         ]
         self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time)
-        self.compiled: CompiledMission = Compiler(self.context, self.supervisor).compile(self.spec)
+
+        def log_retry(policy) -> None:
+            self.events.add(self.sim.time, "retry", node=policy.decorated.bt_path, message=policy.feedback_message)
+
+        self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_retry).compile(self.spec)
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
 
     def request_stop(self, reason: str = "stop requested") -> None:

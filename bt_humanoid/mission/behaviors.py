@@ -109,7 +109,9 @@ def substitute(value: Any, args: dict[str, Any], source: YamlSource, path: tuple
     for name in PLACEHOLDER.findall(value):
         if name not in args:
             valid = ", ".join(sorted(args)) or "none"
-            raise UserError(f"unknown behaviour parameter '${{{name}}}' (parameters: {valid})", where=source.where(path))
+            raise UserError(
+                f"unknown behaviour parameter '${{{name}}}' (parameters: {valid})", where=source.where(path)
+            )
     whole = PLACEHOLDER.fullmatch(value)
     if whole:
         return args[whole.group(1)]

@@ -9,6 +9,7 @@ robot's defaults, in that order.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import py_trees
@@ -48,9 +49,15 @@ def _label(node: NodeSpec) -> str:
 
 
 class Compiler:
-    def __init__(self, context: SkillContext, supervisor: SafetySupervisor) -> None:
+    def __init__(
+        self,
+        context: SkillContext,
+        supervisor: SafetySupervisor,
+        on_retry: Callable[[RecoveryPolicy], None] | None = None,
+    ) -> None:
         self.context = context
         self.supervisor = supervisor
+        self.on_retry = on_retry
 
     def compile(self, spec: MissionSpec) -> CompiledMission:
         robot_defaults = self.context.robot_config.recovery
@@ -81,7 +88,7 @@ class Compiler:
         self.nodes.append((inner, node.path))
         policy = self._recovery_for(node)
         recovery = RecoveryPolicy(
-            RECOVERY_NAME, inner, policy.retries, policy.backoff, self.context.clock, self.supervisor
+            RECOVERY_NAME, inner, policy.retries, policy.backoff, self.context.clock, self.supervisor, self.on_retry
         )
         return SafetyGuard(GUARD_NAME, recovery, self.supervisor)
 

@@ -164,7 +164,9 @@ class MissionLoader:
         if kind in self.library.behaviors:
             return self._behavior_call(kind, body, source, bpath, node_path, stack, spec)
         options = [*structural_kinds(), *REGISTRY, *self.library.behaviors]
-        raise UserError(f"unknown skill or node kind '{kind}'", where=source.where(bpath), hint=did_you_mean(kind, options))
+        raise UserError(
+            f"unknown skill or node kind '{kind}'", where=source.where(bpath), hint=did_you_mean(kind, options)
+        )
 
     def _decorator(self, kind, body, source, bpath, node_path, stack, spec) -> NodeSpec:
         model = LOADER_BODIES[kind]
@@ -184,7 +186,9 @@ class MissionLoader:
             ]
         else:
             if kind == "guard":
-                children.append(self._node(body["condition"], source, (*bpath, "condition"), f"{node_path}.condition", stack))
+                children.append(
+                    self._node(body["condition"], source, (*bpath, "condition"), f"{node_path}.condition", stack)
+                )
             children.append(self._node(body["child"], source, (*bpath, "child"), node_path, stack))
         return spec(category="decorator", settings=settings, children=children)
 

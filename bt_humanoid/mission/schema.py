@@ -156,7 +156,8 @@ def structural_kinds() -> list[str]:
 def json_schema(behaviors: dict[str, type[BaseModel]]) -> dict[str, Any]:
     """JSON Schema of a mission file; ``behaviors`` maps behaviour names to their argument models."""
     bodies = decorator_bodies("Node")
-    kinds: dict[str, tuple[Any, str]] = {k: (list["Node"], d) for k, d in COMPOSITES.items()}
+    # "Node" is a forward reference, resolved by model_rebuild below
+    kinds: dict[str, tuple[Any, str]] = {k: (list["Node"], d) for k, d in COMPOSITES.items()}  # noqa: F821
     kinds |= {k: (bodies[k], d) for k, d in DECORATOR_DESCRIPTIONS.items()}
     kinds |= {k: (info.params, info.description) for k, info in REGISTRY.items()}
     kinds |= {k: (model, model.__doc__ or "") for k, model in behaviors.items()}
@@ -180,7 +181,9 @@ def json_schema(behaviors: dict[str, type[BaseModel]]) -> dict[str, Any]:
     namespace = {"Node": node_union}
     for model in [*bodies.values(), *models]:
         model.model_rebuild(_types_namespace=namespace)
-    mission = create_model("Mission", __base__=MissionHeader, tree=(node_union, Field(description="the behaviour tree")))
+    mission = create_model(
+        "Mission", __base__=MissionHeader, tree=(node_union, Field(description="the behaviour tree"))
+    )
     schema = mission.model_json_schema()
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = "bt-humanoid mission"

@@ -32,8 +32,9 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
         return ConditionResult(f"{obj} on {surface}", holds, f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})")
     if isinstance(condition, AtCondition):
         target = condition.at
-        place, tolerance, yaw_tolerance = (target, 0.15, 15.0) if isinstance(target, str) else (
-            target.place, target.tolerance, target.yaw_tolerance)
+        place, tolerance, yaw_tolerance = (
+            (target, 0.15, 15.0) if isinstance(target, str) else (target.place, target.tolerance, target.yaw_tolerance)
+        )
         px, py, pyaw = truth.sim.world.places[place].pose
         x, y, yaw = truth.robot_pose()
         distance = math.hypot(x - px, y - py)

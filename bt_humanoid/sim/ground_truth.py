@@ -22,9 +22,7 @@ class GroundTruth:
         self.sim = sim
         self.model, self.data = sim.model, sim.data
         robot_root = self.model.body("base").id
-        self.robot_bodies = {
-            i for i in range(self.model.nbody) if self._root_of(i) == robot_root
-        }
+        self.robot_bodies = {i for i in range(self.model.nbody) if self._root_of(i) == robot_root}
 
     def _root_of(self, body: int) -> int:
         while self.model.body_parentid[body] != 0:

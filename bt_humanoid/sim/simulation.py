@@ -12,12 +12,12 @@ import os
 # Off-screen rendering without a display needs EGL; set before mujoco loads.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
+import mujoco
+import numpy as np
 
-from bt_humanoid.sim.assembly import world_spec  # noqa: E402
-from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config  # noqa: E402
-from bt_humanoid.sim.world_config import WorldConfig, load_world_config  # noqa: E402
+from bt_humanoid.sim.assembly import world_spec
+from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
+from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 
 
 class Simulation:
@@ -67,6 +67,9 @@ class Simulation:
         """Index of the actuator that drives ``joint``."""
         joint_id = self.model.joint(joint).id
         for i in range(self.model.nu):
-            if self.model.actuator_trntype[i] == mujoco.mjtTrn.mjTRN_JOINT and self.model.actuator_trnid[i, 0] == joint_id:
+            if (
+                self.model.actuator_trntype[i] == mujoco.mjtTrn.mjTRN_JOINT
+                and self.model.actuator_trnid[i, 0] == joint_id
+            ):
                 return i
         raise KeyError(f"no actuator drives joint '{joint}'")

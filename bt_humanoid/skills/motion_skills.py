@@ -87,7 +87,9 @@ class MoveJoints(Skill):
     def check(cls, params: MoveJointsParams, context: CheckContext) -> list[tuple[str, str]]:
         config = context.robot_config
         if params.posture is not None and params.posture not in config.postures:
-            return [("posture", f"unknown posture '{params.posture}' ({did_you_mean(params.posture, config.postures)})")]
+            return [
+                ("posture", f"unknown posture '{params.posture}' ({did_you_mean(params.posture, config.postures)})")
+            ]
         problems = []
         for joint, value in (params.joints or {}).items():
             if joint not in config.actuated_joints:

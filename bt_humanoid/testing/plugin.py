@@ -1,9 +1,9 @@
 """pytest plugin (registered as an entry point): fixtures for mission scenario tests.
 
-    def test_demo(run_mission):
-        scenario = run_mission("missions/demo.yaml")
-        assert scenario.result.success
-        assert scenario.truth.robot_pose()[0] > 2.0
+def test_demo(run_mission):
+    scenario = run_mission("missions/demo.yaml")
+    assert scenario.result.success
+    assert scenario.truth.robot_pose()[0] > 2.0
 """
 
 from __future__ import annotations

@@ -110,10 +110,14 @@ def print_event(console: Console, event: dict[str, Any]) -> None:
         console.print(f"{stamp} {event['new']:<8} {event['node']}{feedback}", markup=False, highlight=False)
     elif kind == "say":
         console.print(f"{stamp} SAY      {event['text']}", markup=False, highlight=False)
+    elif kind == "retry":
+        console.print(f"{stamp} RETRY    {event['node']}  {event['message']}", markup=False, highlight=False)
     elif kind == "safety":
         console.print(f"{stamp} SAFETY   {event['monitor']}: {event['message']}", markup=False, highlight=False)
     elif kind in ("rest", "moving"):
         state = "robot at rest" if kind == "rest" else "robot STILL MOVING"
-        console.print(f"{stamp} {kind.upper():<8} {state} (max speed {event['max_speed']:.3f})", markup=False, highlight=False)
+        console.print(
+            f"{stamp} {kind.upper():<8} {state} (max speed {event['max_speed']:.3f})", markup=False, highlight=False
+        )
     elif kind == "timeout":
         console.print(f"{stamp} TIMEOUT  {event['message']}", markup=False, highlight=False)

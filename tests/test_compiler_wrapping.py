@@ -1,0 +1,56 @@
+"""Every node the compiler emits sits under a Safety guard and a Recovery policy."""
+
+import pytest
+from py_trees.behaviour import Behaviour
+
+from bt_humanoid.cli import _default_args
+from bt_humanoid.engine.decorators import RecoveryPolicy, SafetyGuard
+from bt_humanoid.mission.behaviors import BehaviorLibrary
+from bt_humanoid.paths import project_root
+from bt_humanoid.testing.scenario import build_run
+
+MISSIONS = sorted((project_root() / "missions").glob("*.yaml"))
+BEHAVIORS = sorted(BehaviorLibrary().behaviors)
+
+
+def assert_fully_wrapped(root: Behaviour) -> int:
+    """Walk the tree; return how many mission nodes were checked."""
+    assert isinstance(root, SafetyGuard), "the root must be a Safety guard"
+    checked = 0
+    for node in root.iterate():
+        if isinstance(node, SafetyGuard):
+            assert isinstance(node.decorated, RecoveryPolicy), f"{node.decorated.name}: guard without recovery"
+            continue
+        if isinstance(node, RecoveryPolicy):
+            assert isinstance(node.parent, SafetyGuard), f"{node.decorated.name}: recovery without guard"
+            continue
+        assert isinstance(node.parent, RecoveryPolicy), f"{node.name} is not wrapped"
+        assert isinstance(node.parent.parent, SafetyGuard), f"{node.name} has no Safety guard"
+        checked += 1
+    return checked
+
+
+@pytest.mark.parametrize("mission", MISSIONS, ids=lambda p: p.name)
+def test_every_mission_is_fully_wrapped(mission):
+    run = build_run(mission)
+    assert assert_fully_wrapped(run.compiled.root) == len(run.compiled.nodes) > 0
+
+
+@pytest.mark.parametrize("behavior", BEHAVIORS)
+def test_every_behaviour_is_fully_wrapped(behavior):
+    args = _default_args(BehaviorLibrary().behaviors[behavior])
+    args = {k: "table" for k in args}  # required behaviour parameters in this repo are place names
+    run = build_run({"mission": f"wrap {behavior}", "tree": {behavior: args}})
+    assert assert_fully_wrapped(run.compiled.root) > 1
+
+
+def test_the_check_catches_an_unwrapped_node():
+    run = build_run({"mission": "x", "tree": {"sequence": [{"wait": {"seconds": 1}}]}})
+    sequence = run.compiled.root.decorated.decorated
+    guard = sequence.children[0]
+    # splice the bare leaf in place of its wrappers: the walk must notice
+    leaf = guard.decorated.decorated
+    leaf.parent = sequence
+    sequence.children[0] = leaf
+    with pytest.raises(AssertionError, match="not wrapped"):
+        assert_fully_wrapped(run.compiled.root)
