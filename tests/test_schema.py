@@ -33,3 +33,9 @@ def test_schema_rejects_what_the_loader_rejects():
         assert not validator.is_valid(mission), mission
     good = {"mission": "x", "tree": {"retry": {"attempts": 2, "child": {"approach": {"place": "table"}}}}}
     assert validator.is_valid(good)
+
+
+def test_readme_reference_matches_the_registry(project_root):
+    from bt_humanoid.docs import reference
+
+    assert reference() in (project_root / "README.md").read_text(), "regenerate with: python -m bt_humanoid.docs"
