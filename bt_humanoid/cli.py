@@ -156,7 +156,7 @@ def validate_file(file: Path) -> str:
     """Validate a mission or behaviour file; returns a one-line description, raises UserError."""
     from bt_humanoid.mission.behaviors import load_behavior
     from bt_humanoid.mission.loader import MissionLoader
-    from bt_humanoid.mission.yaml_source import read_yaml
+    from bt_humanoid.yaml_source import read_yaml
 
     source = read_yaml(file)
     if isinstance(source.data, dict) and "behavior" in source.data:

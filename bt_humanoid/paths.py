@@ -32,10 +32,3 @@ def behaviors_dir() -> Path:
 
 def missions_dir() -> Path:
     return project_root() / "missions"
-
-
-def available(folder: Path, marker: str) -> list[str]:
-    """Names of the subfolders of ``folder`` that contain ``marker``."""
-    if not folder.is_dir():
-        return []
-    return sorted(p.name for p in folder.iterdir() if (p / marker).is_file())

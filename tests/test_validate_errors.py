@@ -259,3 +259,18 @@ def test_valid_files_pass(capsys, project_root):
     files = sorted((project_root / "missions").glob("*.yaml")) + sorted((project_root / "behaviors").glob("*.yaml"))
     code = validate_main([str(f) for f in files])
     assert code == 0, capsys.readouterr().err
+
+
+def test_malformed_world_file_is_reported_at_its_line(tmp_path):
+    from bt_humanoid.errors import UserError
+    from bt_humanoid.sim.world_config import WorldConfig
+    from bt_humanoid.yaml_source import read_config
+
+    folder = tmp_path / "worlds" / "flat"
+    folder.mkdir(parents=True)
+    (folder / "world.yaml").write_text(
+        "name: flat\nmodel: world.xml\nbounds: [[0, 0], [1, 1]]\nplaces: {a: {pose: [0, 0]}}\n"
+    )
+    with pytest.raises(UserError) as raised:
+        read_config("world", tmp_path / "worlds", "flat", "world.yaml", WorldConfig)
+    assert "world.yaml:4" in str(raised.value) and "places.a.pose" in str(raised.value)

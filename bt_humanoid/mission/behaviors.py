@@ -15,8 +15,8 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from bt_humanoid.errors import UserError
-from bt_humanoid.mission.yaml_source import YamlSource, read_yaml
 from bt_humanoid.paths import behaviors_dir
+from bt_humanoid.yaml_source import YamlSource, read_yaml
 
 _TYPES: dict[str, Any] = {"string": str, "number": float, "integer": int, "boolean": bool, "any": Any}
 PLACEHOLDER = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)\}")

@@ -9,6 +9,7 @@ as a UserError naming the place and what would be valid.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, get_args
 
@@ -27,13 +28,13 @@ from bt_humanoid.mission.schema import (
     structural_kinds,
 )
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
-from bt_humanoid.mission.yaml_source import YamlPath, YamlSource, display_path, read_yaml
 from bt_humanoid.sim.assembly import joint_ranges
 from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.world_config import load_world_config
 from bt_humanoid.skills import REGISTRY
 from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.params import is_reference
+from bt_humanoid.yaml_source import YamlPath, YamlSource, display_path, read_yaml
 
 MAX_SUBTREE_DEPTH = 32
 
@@ -108,8 +109,8 @@ class MissionLoader:
             header = MissionHeader.model_validate(header_data)
         except ValidationError as error:
             raise _first_error(error, source, ()) from None
-        robot = load_robot_config_at(header.robot, source)
-        world = load_world_config_at(header.world, source)
+        robot = _config_at(load_robot_config, header.robot, source, "robot")
+        world = _config_at(load_world_config, header.world, source, "world")
         self.checks = CheckContext(robot, world, joint_ranges(robot))
         self._check_success(header, source)
         self._check_recovery(header, source)
@@ -290,17 +291,11 @@ class MissionLoader:
                 )
 
 
-def load_robot_config_at(name: str, source: YamlSource):
+def _config_at(load: Callable[[str], Any], name: str, source: YamlSource, field: str) -> Any:
+    """Load a robot or world config; an unknown name is reported at the mission's line naming it."""
     try:
-        return load_robot_config(name)
+        return load(name)
     except UserError as error:
-        error.where = source.where(("robot",))
-        raise
-
-
-def load_world_config_at(name: str, source: YamlSource):
-    try:
-        return load_world_config(name)
-    except UserError as error:
-        error.where = source.where(("world",))
+        if error.message.startswith("unknown"):
+            error.where = source.where((field,))
         raise

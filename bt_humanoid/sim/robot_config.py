@@ -4,11 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
-from bt_humanoid.errors import UserError, did_you_mean
-from bt_humanoid.paths import available, robots_dir
+from bt_humanoid.paths import robots_dir
+from bt_humanoid.yaml_source import read_config
 
 
 class _Strict(BaseModel):
@@ -110,10 +109,4 @@ class RobotConfig(_Strict):
 
 def load_robot_config(name: str) -> RobotConfig:
     """Read robots/<name>/robot.yaml; unknown names get the list of valid ones."""
-    folder = robots_dir() / name
-    path = folder / "robot.yaml"
-    if not path.is_file():
-        raise UserError(f"unknown robot '{name}'", hint=did_you_mean(name, available(robots_dir(), "robot.yaml")))
-    data = yaml.safe_load(path.read_text())
-    config = RobotConfig.model_validate({**data, "folder": folder})
-    return config
+    return read_config("robot", robots_dir(), name, "robot.yaml", RobotConfig)  # type: ignore[return-value]

@@ -5,11 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field
 
 from bt_humanoid.errors import UserError, did_you_mean
-from bt_humanoid.paths import available, worlds_dir
+from bt_humanoid.paths import worlds_dir
+from bt_humanoid.yaml_source import read_config
 
 Pose2D = tuple[float, float, float]  # x [m], y [m], yaw [deg]
 Region = tuple[tuple[float, float], tuple[float, float]]
@@ -67,9 +67,4 @@ class WorldConfig(_Strict):
 
 def load_world_config(name: str) -> WorldConfig:
     """Read worlds/<name>/world.yaml; unknown names get the list of valid ones."""
-    folder = worlds_dir() / name
-    path = folder / "world.yaml"
-    if not path.is_file():
-        raise UserError(f"unknown world '{name}'", hint=did_you_mean(name, available(worlds_dir(), "world.yaml")))
-    data = yaml.safe_load(path.read_text())
-    return WorldConfig.model_validate({**data, "folder": folder})
+    return read_config("world", worlds_dir(), name, "world.yaml", WorldConfig)  # type: ignore[return-value]

@@ -8,8 +8,9 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+from pydantic import BaseModel, ValidationError
 
-from bt_humanoid.errors import UserError
+from bt_humanoid.errors import UserError, did_you_mean
 
 YamlPath = tuple[str | int, ...]
 
@@ -63,6 +64,22 @@ def read_yaml(file: Path, text: str | None = None) -> YamlSource:
         raise UserError(f"YAML error: {error}", where=display_path(file)) from None
     finally:
         loader.dispose()
+
+
+def read_config(kind: str, folder: Path, name: str, filename: str, model: type[BaseModel]) -> BaseModel:
+    """Read ``folder/name/filename`` (a robot.yaml or world.yaml) into ``model``, errors at file:line."""
+    path = folder / name / filename
+    if not path.is_file():
+        valid = sorted(p.name for p in folder.iterdir() if (p / filename).is_file()) if folder.is_dir() else []
+        raise UserError(f"unknown {kind} '{name}'", hint=did_you_mean(name, valid))
+    source = read_yaml(path)
+    try:
+        return model.model_validate({**(source.data or {}), "folder": path.parent})
+    except ValidationError as error:
+        first = error.errors()[0]
+        location = tuple(first["loc"])
+        field = ".".join(map(str, location))
+        raise UserError(f"{field}: {first['msg']}", where=source.where(location)) from None
 
 
 def _convert(loader: yaml.SafeLoader, node: yaml.Node, path: YamlPath, source: YamlSource) -> Any:
