@@ -6,7 +6,7 @@ from collections.abc import Callable
 from enum import Enum
 
 import numpy as np
-from ruckig import InputParameter, Result, Ruckig, Trajectory
+from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 
 class MotionStatus(Enum):
@@ -58,8 +58,6 @@ def plan_trajectory(
     phase_sync: bool = False,
 ) -> Trajectory:
     """A jerk-limited Ruckig trajectory from a state to rest at ``target`` (or to rest anywhere if ``brake``)."""
-    from ruckig import ControlInterface, Synchronization
-
     dofs = len(position)
     inp = InputParameter(dofs)
     inp.current_position = position.tolist()
