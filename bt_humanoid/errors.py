@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
+from typing import Any
+
+from pydantic import ValidationError
 
 
 class UserError(Exception):
@@ -30,3 +33,22 @@ def did_you_mean(name: str, options: Iterable[str]) -> str:
     if close:
         return f"did you mean '{close[0]}'? valid: {valid}"
     return f"valid: {valid}"
+
+
+def describe_validation_error(error: ValidationError) -> tuple[tuple[Any, ...], str]:
+    """The first pydantic error as (location, message phrased for people).
+
+    The location points at the offending key, or at the mapping that lacks a
+    required one.
+    """
+    first = error.errors()[0]
+    location = tuple(first["loc"])
+    field = ".".join(str(part) for part in location)
+    kind = first["type"]
+    if kind == "missing":
+        return location[:-1], f"missing required parameter '{field}'"
+    if kind == "extra_forbidden":
+        return location, f"unknown parameter '{field}'"
+    got = first.get("input")
+    shown = f" (got {got!r})" if got is not None and not isinstance(got, dict | list) else ""
+    return location, f"{field + ': ' if field else ''}{first['msg']}{shown}"

@@ -10,7 +10,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from bt_humanoid.errors import UserError, did_you_mean
+from bt_humanoid.errors import UserError, describe_validation_error, did_you_mean
 
 YamlPath = tuple[str | int, ...]
 
@@ -76,10 +76,8 @@ def read_config(kind: str, folder: Path, name: str, filename: str, model: type[B
     try:
         return model.model_validate({**(source.data or {}), "folder": path.parent})
     except ValidationError as error:
-        first = error.errors()[0]
-        location = tuple(first["loc"])
-        field = ".".join(map(str, location))
-        raise UserError(f"{field}: {first['msg']}", where=source.where(location)) from None
+        location, message = describe_validation_error(error)
+        raise UserError(message, where=source.where(location)) from None
 
 
 def _convert(loader: yaml.SafeLoader, node: yaml.Node, path: YamlPath, source: YamlSource) -> Any:

@@ -14,24 +14,23 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from bt_humanoid.errors import UserError
+from bt_humanoid.errors import UserError, describe_validation_error
 from bt_humanoid.paths import behaviors_dir
+from bt_humanoid.strict_model import StrictModel
 from bt_humanoid.yaml_source import YamlSource, read_yaml
 
 _TYPES: dict[str, Any] = {"string": str, "number": float, "integer": int, "boolean": bool, "any": Any}
 PLACEHOLDER = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)\}")
 
 
-class BehaviorParam(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class BehaviorParam(StrictModel):
     type: Literal["string", "number", "integer", "boolean", "any"] = "string"
     default: Any = None
     required: bool = False
     description: str = ""
 
 
-class BehaviorHeader(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class BehaviorHeader(StrictModel):
     behavior: str = Field(pattern=r"^[a-z][a-z0-9_]*$")
     description: str = ""
     params: dict[str, BehaviorParam] = Field(default_factory=dict)
@@ -66,9 +65,8 @@ def load_behavior(file: Path) -> Behavior:
     try:
         header = BehaviorHeader.model_validate(source.data)
     except ValidationError as error:
-        first = error.errors()[0]
-        loc = tuple(first["loc"])
-        raise UserError(f"{'.'.join(map(str, loc))}: {first['msg']}", where=source.where(loc)) from None
+        location, message = describe_validation_error(error)
+        raise UserError(message, where=source.where(location)) from None
     return Behavior(header.behavior, header.description, source, _args_model(header.behavior, header))
 
 

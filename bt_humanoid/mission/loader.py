@@ -15,7 +15,7 @@ from typing import Any, get_args
 
 from pydantic import BaseModel, ValidationError
 
-from bt_humanoid.errors import UserError, did_you_mean
+from bt_humanoid.errors import UserError, describe_validation_error, did_you_mean
 from bt_humanoid.mission.behaviors import BehaviorLibrary, substitute
 from bt_humanoid.mission.schema import (
     COMPOSITES,
@@ -41,22 +41,8 @@ MAX_SUBTREE_DEPTH = 32
 
 def _first_error(error: ValidationError, source: YamlSource, base: YamlPath, prefix: str = "") -> UserError:
     """The first pydantic error, positioned in the YAML and phrased for people."""
-    first = error.errors()[0]
-    loc = tuple(first["loc"])
-    field = ".".join(str(part) for part in loc)
-    kind = first["type"]
-    if kind == "missing":
-        message = f"missing required parameter '{field}'"
-        position = (*base,)
-    elif kind == "extra_forbidden":
-        message = f"unknown parameter '{field}'"
-        position = (*base, *loc)
-    else:
-        got = first.get("input")
-        shown = f" (got {got!r})" if got is not None and not isinstance(got, dict | list) else ""
-        message = f"{field + ': ' if field else ''}{first['msg']}{shown}"
-        position = (*base, *loc)
-    return UserError(f"{prefix}{message}", where=source.where(position))
+    location, message = describe_validation_error(error)
+    return UserError(f"{prefix}{message}", where=source.where((*base, *location)))
 
 
 def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: YamlPath, prefix: str) -> BaseModel:

@@ -15,55 +15,51 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from bt_humanoid.skills import REGISTRY
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
+from bt_humanoid.strict_model import StrictModel
 
 # --- mission-level sections ----------------------------------------------------
 
 
-class RecoverySettings(_Strict):
+class RecoverySettings(StrictModel):
     retries: int = Field(0, ge=0, le=10, description="extra attempts after a failure")
     backoff: float = Field(0.5, ge=0, le=60, description="simulation seconds between attempts")
 
 
-class RecoverySection(_Strict):
+class RecoverySection(StrictModel):
     retries: int | None = Field(None, ge=0, le=10, description="extra attempts of a failed leaf (default: robot's)")
     backoff: float | None = Field(None, ge=0, le=60, description="seconds between attempts (default: robot's)")
     skills: dict[str, RecoverySettings] = Field(default_factory=dict, description="per-skill overrides")
 
 
-class SafetySection(_Strict):
+class SafetySection(StrictModel):
     max_base_speed: float | None = Field(None, gt=0, le=2.0, description="m/s cap on base motion")
     joint_limit_margin: float | None = Field(None, ge=0, le=0.5, description="rad past a joint range that trips")
     time_budget: float | None = Field(None, gt=0, le=86400, description="simulation seconds for the whole mission")
 
 
-class PlaceTolerance(_Strict):
+class PlaceTolerance(StrictModel):
     place: str
     tolerance: float = Field(0.15, gt=0, description="metres from the place's pose")
     yaw_tolerance: float = Field(15.0, gt=0, description="degrees from the place's heading")
 
 
-class OnCondition(_Strict):
+class OnCondition(StrictModel):
     on: tuple[str, str] = Field(description="[object, surface]: the object rests on the surface")
 
 
-class AtCondition(_Strict):
+class AtCondition(StrictModel):
     at: str | PlaceTolerance = Field(description="the robot stands at a named place")
 
 
-class InHandCondition(_Strict):
+class InHandCondition(StrictModel):
     in_hand: str = Field(description="the object is held between the fingers of a gripper")
 
 
-class UprightCondition(_Strict):
+class UprightCondition(StrictModel):
     upright: str = Field(description="the object stands upright (within 15°)")
 
 
-class GripperCondition(_Strict):
+class GripperCondition(StrictModel):
     gripper: tuple[Literal["left", "right"], Literal["open", "closed"]] = Field(description="[side, state]")
 
 
@@ -71,7 +67,7 @@ SuccessCondition = OnCondition | AtCondition | InHandCondition | UprightConditio
 CONDITION_KINDS = ("on", "at", "in_hand", "upright", "gripper")
 
 
-class MissionHeader(_Strict):
+class MissionHeader(StrictModel):
     """Everything in a mission file except its tree."""
 
     mission: str = Field(description="what the mission does, in a few words")

@@ -4,23 +4,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from bt_humanoid.paths import robots_dir
+from bt_humanoid.strict_model import StrictModel
 from bt_humanoid.yaml_source import read_config
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class RobotParts(_Strict):
+class RobotParts(StrictModel):
     lower_body: str
     upper_body: str
     mount_site: str = "mount"
 
 
-class BaseLimits(_Strict):
+class BaseLimits(StrictModel):
     max_speed: float = 0.8
     max_accel: float = 0.8
     max_jerk: float = 3.0
@@ -29,12 +26,12 @@ class BaseLimits(_Strict):
     max_yaw_jerk: float = 8.0
 
 
-class BaseTolerance(_Strict):
+class BaseTolerance(StrictModel):
     position: float = 0.02
     yaw_deg: float = 2.0
 
 
-class BaseConfig(_Strict):
+class BaseConfig(StrictModel):
     joints: dict[str, str]
     actuators: dict[str, str]
     footprint_radius: float = 0.3
@@ -42,38 +39,38 @@ class BaseConfig(_Strict):
     tolerance: BaseTolerance = BaseTolerance()
 
 
-class GripperConfig(_Strict):
+class GripperConfig(StrictModel):
     joints: list[str]
     open: float
     closed: float
     grip_site: str
 
 
-class CameraConfig(_Strict):
+class CameraConfig(StrictModel):
     width: int = 320
     height: int = 240
     depth: bool = True
     rate_hz: float = 10.0
 
 
-class MotionLimits(_Strict):
+class MotionLimits(StrictModel):
     velocity: float
     acceleration: float
     jerk: float
 
 
-class SafetyDefaults(_Strict):
+class SafetyDefaults(StrictModel):
     max_base_speed: float = 0.8
     joint_limit_margin: float = 0.01
     time_budget: float = 600.0
 
 
-class RecoveryDefaults(_Strict):
+class RecoveryDefaults(StrictModel):
     retries: int = 0
     backoff: float = 0.5
 
 
-class RobotConfig(_Strict):
+class RobotConfig(StrictModel):
     name: str
     description: str = ""
     parts: RobotParts

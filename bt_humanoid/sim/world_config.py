@@ -5,44 +5,41 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.paths import worlds_dir
+from bt_humanoid.strict_model import StrictModel
 from bt_humanoid.yaml_source import read_config
 
 Pose2D = tuple[float, float, float]  # x [m], y [m], yaw [deg]
 Region = tuple[tuple[float, float], tuple[float, float]]
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class Place(_Strict):
+class Place(StrictModel):
     pose: Pose2D
     region: Region | None = None
     kind: Literal["room", "furniture", "spot"] = "spot"
 
 
-class Surface(_Strict):
+class Surface(StrictModel):
     geom: str
     place: str
 
 
-class WorldObject(_Strict):
+class WorldObject(StrictModel):
     body: str
     kind: str
     colour: str
     upright: bool = False
 
 
-class Person(_Strict):
+class Person(StrictModel):
     body: str
     aliases: list[str] = Field(default_factory=list)
 
 
-class WorldConfig(_Strict):
+class WorldConfig(StrictModel):
     name: str
     description: str = ""
     model: str

@@ -9,8 +9,9 @@ from py_trees.common import Status
 from pydantic import BaseModel, ValidationError
 
 from bt_humanoid.control.motion import MotionHandle, MotionStatus
+from bt_humanoid.errors import describe_validation_error
 from bt_humanoid.skills.context import CheckContext, SkillContext
-from bt_humanoid.skills.params import format_validation_error, resolve_references
+from bt_humanoid.skills.params import resolve_references
 
 
 class Skill(py_trees.behaviour.Behaviour):
@@ -64,7 +65,7 @@ class Skill(py_trees.behaviour.Behaviour):
             self.error = f"{self.path}: blackboard has no {missing.args[0]!r}"
             return
         except ValidationError as error:
-            self.error = f"{self.path}: {format_validation_error(error)}"
+            self.error = f"{self.path}: {describe_validation_error(error)[1]}"
             return
         try:
             self.motion = self.start()

@@ -5,10 +5,11 @@ from __future__ import annotations
 from typing import Any, Literal
 
 from py_trees.common import Status
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel
 
 _COMPARISONS = {
     "equals": lambda a, b: a == b,
@@ -18,8 +19,7 @@ _COMPARISONS = {
 }
 
 
-class CheckParams(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class CheckParams(StrictModel):
     key: str = Field(description="blackboard key")
     op: Literal["exists", "equals", "not_equals", "less", "greater"] = Field("equals", description="comparison")
     value: Any = Field(None, description="value to compare with (not used by exists)")
@@ -45,8 +45,7 @@ class Check(Skill):
         return Status.SUCCESS if ok else Status.FAILURE
 
 
-class SetParams(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class SetParams(StrictModel):
     key: str = Field(description="blackboard key")
     value: Any = Field(description="value to store")
 

@@ -5,20 +5,17 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.errors import did_you_mean
 from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel
 
 
-class _Params(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class MoveBaseParams(_Params):
+class MoveBaseParams(StrictModel):
     """Either a named place, or a pose (x, y, yaw) in the world or relative to the robot."""
 
     place: str | None = Field(None, description="named place to drive to; yaw, if given, overrides its heading")
@@ -67,7 +64,7 @@ class MoveBase(Skill):
         return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
 
 
-class MoveJointsParams(_Params):
+class MoveJointsParams(StrictModel):
     posture: str | None = Field(None, description="a named posture from robot.yaml")
     joints: dict[str, float] | None = Field(None, description="joint name → position (rad, or m for fingers)")
     speed: float = Field(1.0, gt=0, le=1.0, description="fraction of the joints' velocity and acceleration limits")
@@ -106,7 +103,7 @@ class MoveJoints(Skill):
         return self.context.robot.joints.move(dict(targets), speed_scale=p.speed)
 
 
-class GripperParams(_Params):
+class GripperParams(StrictModel):
     action: Literal["open", "close"] = Field(description="open the jaws, or close until they stall on something")
     side: Literal["left", "right"] = Field("right", description="which hand")
 

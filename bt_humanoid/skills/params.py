@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import ValidationError
-
 
 def is_reference(value: Any) -> bool:
     """``"$key"`` reads the blackboard when the leaf starts (``"$$"`` escapes a literal dollar)."""
@@ -22,15 +20,3 @@ def resolve_references(value: Any, blackboard: Any) -> Any:
     if isinstance(value, list):
         return [resolve_references(v, blackboard) for v in value]
     return value
-
-
-def format_validation_error(error: ValidationError) -> str:
-    """The first error of a pydantic ValidationError as one readable line."""
-    first = error.errors()[0]
-    location = ".".join(str(part) for part in first["loc"])
-    message = first["msg"]
-    if first["type"] == "missing":
-        message = "required parameter is missing"
-    elif first["type"] == "extra_forbidden":
-        message = "unknown parameter"
-    return f"{location}: {message}" if location else message

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel
 
 
-class SayParams(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class SayParams(StrictModel):
     text: str = Field(min_length=1, max_length=500, description="what to say")
 
 

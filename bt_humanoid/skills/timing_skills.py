@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from py_trees.common import Status
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel
 
 
-class WaitParams(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class WaitParams(StrictModel):
     seconds: float = Field(ge=0, le=3600, description="simulation seconds to wait")
 
 
