@@ -61,7 +61,7 @@ def run_main(argv: list[str] | None = None) -> int:
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
         spec = MissionLoader().load_file(args.mission)
-        run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz, speak=lambda text: None)
+        run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz)
         recorder = None
         if args.record:
             from bt_humanoid.viz.recorder import VideoRecorder

@@ -9,7 +9,7 @@ def run(tree, **header):
     return run_scenario({"mission": "t", "tree": tree, **header})
 
 
-def leaf(node, scenario, kind):
+def leaf(scenario, kind):
     return [e for e in scenario.events if e["event"] == "status" and e["node"].endswith(kind)]
 
 
@@ -83,7 +83,7 @@ def test_guard_halts_the_child_when_its_condition_stops_holding():
     }
     s = run(tree, blackboard={"go": True})
     assert s.result.tree_status == "FAILURE" and s.result.sim_time < 1.0
-    assert [e["new"] for e in leaf(None, s, "guard.wait")] == ["RUNNING", "INVALID"]
+    assert [e["new"] for e in leaf(s, "guard.wait")] == ["RUNNING", "INVALID"]
 
 
 def test_reactive_sequence_rechecks_earlier_children():

@@ -17,11 +17,8 @@ from bt_humanoid.mission.compiler import CompiledMission, Compiler
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.mission.success import ConditionResult, check_condition
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
-from bt_humanoid.sim.assembly import joint_ranges
 from bt_humanoid.sim.ground_truth import GroundTruth
-from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.simulation import Simulation
-from bt_humanoid.sim.world_config import load_world_config
 from bt_humanoid.skills.context import Blackboard, SkillContext
 
 
@@ -69,8 +66,8 @@ class MissionRun:
 
     def __post_init__(self) -> None:
         header = self.spec.header
-        robot_config = load_robot_config(header.robot)
-        world = load_world_config(header.world)
+        known = self.spec.known
+        robot_config, world = known.robot_config, known.world
         self.sim = Simulation(world, robot_config)
         self.sim.reset(self.seed if self.seed is not None else header.seed)
         self.robot = RobotController(self.sim)
@@ -89,7 +86,7 @@ class MissionRun:
         self.context = SkillContext(
             robot_config=robot_config,
             world=world,
-            joint_ranges=joint_ranges(robot_config),
+            joint_ranges=known.joint_ranges,
             robot=self.robot,
             clock=lambda: self.sim.time,
             max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),

@@ -101,7 +101,7 @@ class MissionLoader:
         self._check_success(header, source)
         self._check_recovery(header, source)
         tree = self._node(data["tree"], source, ("tree",), "tree", stack=())
-        return MissionSpec(header, tree, source.file)
+        return MissionSpec(header, tree, self.checks, source.file)
 
     # --- nodes ----------------------------------------------------------------------
 

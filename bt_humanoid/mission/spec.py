@@ -9,6 +9,7 @@ from typing import Any, Literal
 from pydantic import BaseModel
 
 from bt_humanoid.mission.schema import MissionHeader, RecoverySettings
+from bt_humanoid.skills.context import CheckContext
 
 Category = Literal["composite", "decorator", "skill", "behavior"]
 
@@ -42,4 +43,6 @@ class NodeSpec:
 class MissionSpec:
     header: MissionHeader
     tree: NodeSpec
+    #: the robot and world configs the mission was checked against
+    known: CheckContext
     file: Path | None = None

@@ -35,9 +35,7 @@ def _quiet_empty_prefix_warning():
 
     mujoco.set_mju_user_warning(handler)
     try:
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message=_EMPTY_PREFIX_WARNING)
-            yield
+        yield
     finally:
         mujoco.set_mju_user_warning(previous)
 
