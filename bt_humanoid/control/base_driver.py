@@ -43,6 +43,7 @@ class BaseDriver:
         self.start = 0.0
         self.target = self.reference.copy()
         self.braking = False
+        self.tracking = False  # following references streamed by the whole-body controller
 
     def pose(self) -> np.ndarray:
         """Odometry: (x, y, yaw) from the base joint encoders."""
@@ -71,15 +72,26 @@ class BaseDriver:
         self.trajectory = plan_trajectory(start, self.velocity, self.acceleration, target, plan_limits, phase_sync=True)
         self.start = self.io.time
         self.target = target
-        self.braking = False
+        self.braking = self.tracking = False
         self.handle = MotionHandle(f"driving {distance:.2f} m", on_cancel=lambda _: self.brake())
         return self.handle
+
+    def track(self, reference: np.ndarray, velocity: np.ndarray) -> None:
+        """Follow a streamed reference pose and velocity (one control step's worth); pre-empts any goal."""
+        if self.handle is not None:
+            self.handle.fail("pre-empted by a whole-body motion")
+            self.handle = None
+        self.trajectory, self.braking, self.tracking = None, False, True
+        self.reference = np.array(reference, dtype=float)
+        self.velocity = np.array(velocity, dtype=float)
+        self.acceleration = np.zeros(3)
 
     def brake(self) -> None:
         """Cancel the goal and decelerate to rest under the base limits."""
         if self.handle is not None:
             self.handle.fail("halted: braking")
             self.handle = None
+        self.tracking = False
         limits = self.config.limits
         plan_limits = (
             np.array([limits.max_speed, limits.max_speed, limits.max_yaw_rate]) * 1.5,
@@ -95,6 +107,11 @@ class BaseDriver:
 
     def step(self) -> None:
         """Sample the plan, correct the tracking error, command the actuators."""
+        if self.tracking:
+            error = self.reference - self.pose()
+            error[2] = wrap_angle(error[2])
+            self.io.command(self.actuators, self.velocity + POSITION_GAIN * error)
+            return
         if self.trajectory is None:
             self.io.command(self.actuators, np.zeros(3))
             return

@@ -14,6 +14,9 @@ from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.sim.robot_config import GripperConfig
 
 EMPTY_WIDTH = 0.004  # m: a gap below this after closing means nothing is held
+STALL_SPEED = 0.004  # m/s: fingers slower than this have stopped closing
+MIN_CLOSING_TIME = 0.15  # s before a stall counts (the fingers must get going first)
+GRASP_TIMEOUT = 3.0  # s
 
 
 class GripperController:
@@ -22,6 +25,32 @@ class GripperController:
     def __init__(self, joints: JointReferenceController, grippers: dict[str, GripperConfig]) -> None:
         self.joints = joints
         self.grippers = grippers
+        self._grasps: dict[str, tuple[MotionHandle, float]] = {}
+
+    def grasp(self, side: str) -> MotionHandle:
+        """Close until the fingers stall; succeeds holding something, fails having closed on nothing."""
+        self.command(side, "close")
+        handle = MotionHandle(f"closing the {side} gripper")
+        self._grasps[side] = (handle, self.joints.io.time)
+        return handle
+
+    def step(self) -> None:
+        """Judge grasps in progress: stalled on something, or shut on nothing."""
+        for side, (handle, started) in list(self._grasps.items()):
+            idx = self.joints.indices(self.grippers[side].joints)
+            if handle.done:
+                del self._grasps[side]
+                continue
+            elapsed = self.joints.io.time - started
+            stalled = np.all(np.abs(self.joints.io.velocities()[idx]) < STALL_SPEED)
+            if elapsed < MIN_CLOSING_TIME or not (stalled or elapsed > GRASP_TIMEOUT):
+                continue
+            width = self.width(side)
+            if width > EMPTY_WIDTH:
+                handle.succeed(f"holding something {width * 100:.1f} cm wide")
+            else:
+                handle.fail(f"missed: the {side} gripper closed on nothing")
+            del self._grasps[side]
 
     def command(self, side: str, action: str) -> MotionHandle:
         """``action`` is "open" or "close"; the handle's result reports held / empty."""

@@ -65,6 +65,13 @@ class JointReferenceController:
         self.goals.append(_Goal(handle, idx, trajectory, self.io.time, goal_q, settle_check))
         return handle
 
+    def track(self, joints: np.ndarray, position: np.ndarray, velocity: np.ndarray) -> None:
+        """Set references for ``joints`` directly (streamed each control step); pre-empts their goals."""
+        self._preempt(joints, "pre-empted by a whole-body motion")
+        self.position[joints] = np.clip(position, self.io.lower[joints], self.io.upper[joints])
+        self.velocity[joints] = velocity
+        self.acceleration[joints] = 0.0
+
     def brake(self, joints: np.ndarray | None = None) -> None:
         """Cancel goals and bring references (all, or ``joints``) to rest as fast as the limits allow."""
         idx = np.arange(len(self.joints)) if joints is None else joints

@@ -12,6 +12,7 @@ import numpy as np
 from bt_humanoid.control.base_driver import BaseDriver
 from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.joint_motion import JointReferenceController
+from bt_humanoid.control.whole_body import WholeBodyController
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.robot_io import MujocoRobotIO
 from bt_humanoid.sim.simulation import Simulation
@@ -29,13 +30,23 @@ class RobotController:
         self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)
         self.joints = JointReferenceController(self.body_io, self.config)
         self.grippers = GripperController(self.joints, self.config.grippers)
+        io = self.body_io
+        ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
+        self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
+
+    def set_control_period(self, period: float) -> None:
+        """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""
+        self.whole_body.dt = period
 
     def step(self) -> None:
+        self.whole_body.step()  # streams references first, the controllers below then track them
         self.base.step()
         self.joints.step()
+        self.grippers.step()
 
     def brake(self) -> None:
         """Halt every motion: base and joints decelerate to rest under their limits."""
+        self.whole_body.cancel()
         self.base.brake()
         self.joints.brake()
 

@@ -40,6 +40,7 @@ class Executor:
         self.tick_period = 1.0 / tick_hz
         steps_per_control = max(1, round(1.0 / (control_hz * sim.timestep)))
         self.steps_per_control = steps_per_control
+        robot.set_control_period(steps_per_control * sim.timestep)
         self.controls_per_tick = max(1, round(self.tick_period / (steps_per_control * sim.timestep)))
         self.tick_count = 0
         self.observers: list[Callable[[], None]] = []  # called after every control period (recorder, pacing)

@@ -16,6 +16,7 @@ from bt_humanoid.engine.executor import Executor
 from bt_humanoid.mission.compiler import CompiledMission, Compiler
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.mission.success import ConditionResult, check_condition
+from bt_humanoid.perception.declared import declared_world_model
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.simulation import Simulation
@@ -92,6 +93,7 @@ class MissionRun:
             max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),
             blackboard=Blackboard(header.blackboard),
             speak=say,
+            world_model=declared_world_model(world, self.sim.model),
         )
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bt_humanoid.control.robot import RobotController
+from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.world_config import WorldConfig
 
@@ -49,3 +50,4 @@ class SkillContext(CheckContext):
     max_base_speed: float = 0.8  # m/s: the mission's safety cap
     blackboard: Blackboard = field(default_factory=Blackboard)
     speak: Callable[[str], None] = print
+    world_model: WorldModel = field(default_factory=WorldModel)  # what the robot believes; skills read only this

@@ -1,0 +1,99 @@
+"""Pinocchio kinematics of the robot, indexed by the whole-body controller's joints.
+
+The model is built from the same MJCF MuJoCo simulates (written frame-free by
+``write_robot_mjcf``). The controller works on a reduced set of joints (base
+x/y/yaw, waist, arms, head); every Jacobian returned here has one column per
+controlled joint, in that order.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+
+from bt_humanoid.sim.assembly import robot_spec, write_robot_mjcf
+from bt_humanoid.sim.robot_config import RobotConfig
+
+
+_models: dict[Path, pin.Model] = {}
+
+
+def _model_for(config: RobotConfig) -> pin.Model:
+    """Pinocchio model of a robot, built once per process (a few tens of ms)."""
+    if config.folder in _models:
+        return _models[config.folder]
+    with tempfile.TemporaryDirectory() as folder:
+        model = pin.buildModelFromMJCF(str(write_robot_mjcf(config, Path(folder) / "robot.xml")))
+    _add_camera_frames(model, config)
+    _models[config.folder] = model
+    return model
+
+
+def _add_camera_frames(model: pin.Model, config: RobotConfig) -> None:
+    """Pinocchio does not import MJCF cameras: add each as a frame on its body (looking along -z)."""
+    mj_model = robot_spec(config).compile()
+    for i in range(mj_model.ncam):
+        camera = mj_model.camera(i)
+        body = mj_model.body(int(mj_model.cam_bodyid[i])).name
+        parent = model.getFrameId(body, pin.FrameType.BODY)
+        rotation = np.zeros(9)
+        mujoco.mju_quat2Mat(rotation, mj_model.cam_quat[i])
+        placement = model.frames[parent].placement * pin.SE3(rotation.reshape(3, 3), mj_model.cam_pos[i].copy())
+        model.addFrame(pin.Frame(camera.name, model.frames[parent].parentJoint, parent, placement, pin.FrameType.OP_FRAME))
+
+
+class RobotKinematics:
+    """Forward kinematics and frame Jacobians over the controlled joints."""
+
+    def __init__(self, config: RobotConfig, joints: list[str]) -> None:
+        self.model = _model_for(config)
+        self.data = self.model.createData()
+        self.joints = list(joints)
+        self.q = pin.neutral(self.model)
+        self.positions = np.zeros(len(self.joints))  # controlled joints, as last set by update()
+        base = [config.base.joints[axis] for axis in ("x", "y", "yaw")]
+        q_index, v_index = [], []
+        for joint in self.joints:
+            if joint in base:
+                # MJCF base x/y/yaw become one composite joint in Pinocchio, in that order
+                composite = self.model.joints[self.model.getJointId(f"Composite_{base[0]}")]
+                offset = base.index(joint)
+                q_index.append(composite.idx_q + offset)
+                v_index.append(composite.idx_v + offset)
+            else:
+                pin_joint = self.model.joints[self.model.getJointId(joint)]
+                q_index.append(pin_joint.idx_q)
+                v_index.append(pin_joint.idx_v)
+        self._q_index = np.array(q_index)
+        self._v_index = np.array(v_index)
+        self._frame_ids: dict[str, int] = {}
+
+    def index(self, joint: str) -> int:
+        return self.joints.index(joint)
+
+    def update(self, positions: np.ndarray) -> None:
+        """Set the controlled joints (other joints stay at their last value) and recompute kinematics."""
+        self.positions = np.array(positions, dtype=float)
+        self.q[self._q_index] = self.positions
+        pin.computeJointJacobians(self.model, self.data, self.q)
+        pin.updateFramePlacements(self.model, self.data)
+
+    def frame_id(self, frame: str) -> int:
+        if frame not in self._frame_ids:
+            if not self.model.existFrame(frame):
+                raise KeyError(f"robot has no frame {frame!r}")
+            self._frame_ids[frame] = self.model.getFrameId(frame)
+        return self._frame_ids[frame]
+
+    def pose(self, frame: str) -> pin.SE3:
+        """World pose of a frame (site, body or camera name)."""
+        return self.data.oMf[self.frame_id(frame)]
+
+    def jacobian(self, frame: str) -> np.ndarray:
+        """6 × n Jacobian (linear; angular) of the frame origin in world-aligned axes."""
+        full = pin.getFrameJacobian(self.model, self.data, self.frame_id(frame), pin.LOCAL_WORLD_ALIGNED)
+        return full[:, self._v_index]

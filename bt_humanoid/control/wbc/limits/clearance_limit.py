@@ -1,0 +1,30 @@
+"""Keep a frame above a height: the hand clears the support surface while approaching."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.limits.base import Inequality, Limit
+
+
+class ClearanceLimit(Limit):
+    """``frame`` stays at or above ``height`` (world z) whenever it is over ``region`` [[x0, y0], [x1, y1]].
+
+    Outside the region (beside the table) the hand may go lower, so it can
+    come up from below the edge height only once it is clear of the edge.
+    """
+
+    def __init__(self, frame: str, height: float, region: np.ndarray, gain: float = 0.5) -> None:
+        self.frame = frame
+        self.height = height
+        self.region = np.asarray(region, dtype=float)
+        self.gain = gain
+
+    def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
+        position = kinematics.pose(self.frame).translation
+        inside = np.all(position[:2] >= self.region[0]) and np.all(position[:2] <= self.region[1])
+        if not inside:
+            return Inequality.none(len(kinematics.joints))
+        row = kinematics.jacobian(self.frame)[2:3]
+        return Inequality(row, np.array([self.gain * (self.height - position[2])]))

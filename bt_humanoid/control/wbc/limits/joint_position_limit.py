@@ -1,0 +1,23 @@
+"""Stay inside the joints' position ranges, approaching the bounds no faster than a fraction per step."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bt_humanoid.control.wbc.kinematics import RobotKinematics
+
+
+class JointPositionLimit:
+    """Box bounds on Δq from [lower, upper] (± ``margin``), for joints whose range is finite."""
+
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, margin: float = 0.02, gain: float = 0.5) -> None:
+        self.lower = lower + margin
+        self.upper = upper - margin
+        self.gain = gain
+
+    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        q = kinematics.positions
+        # already outside (e.g. started there): allow no motion further out, any motion back in
+        low = np.minimum(self.gain * (self.lower - q), 0.0)
+        high = np.maximum(self.gain * (self.upper - q), 0.0)
+        return low, high

@@ -1,0 +1,309 @@
+"""Whole-body motions: the QP of control/wbc run at the control rate, driving base, waist, arms and head.
+
+A goal (reach a hand pose, look at a point) is a set of tasks whose targets
+move along a Ruckig trajectory. Each control step the controller solves the
+QP at its reference configuration, integrates the step into new references
+and streams them to the joint position controllers and the base driver.
+Completion is judged on the measured configuration (the encoders), so a hand
+held back by contact does not count as arrived.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from bt_humanoid.control.base_driver import BaseDriver
+from bt_humanoid.control.joint_motion import JointReferenceController
+from bt_humanoid.control.motion import MotionHandle, plan_trajectory
+from bt_humanoid.control.wbc import RobotKinematics, solve_ik
+from bt_humanoid.control.wbc.limits import JointPositionLimit, Limit, TorsoMarginLimit, VelocityLimit
+from bt_humanoid.control.wbc.tasks import DampingTask, FrameTask, GazeTask, PostureTask, Task
+from bt_humanoid.sim.robot_config import RobotConfig
+
+HAND_SPEED = 0.3  # m/s along a reach
+HAND_ACCEL = 0.8  # m/s^2
+HAND_JERK = 6.0  # m/s^3
+HAND_TURN_RATE = 1.2  # rad/s of hand orientation change
+POSITION_TOLERANCE = 0.012  # m: measured hand within this of the target counts as arrived
+ORIENTATION_TOLERANCE = 0.12  # rad
+SETTLE_TIMEOUT = 1.5  # s after the trajectory ends before an unfinished reach fails
+HAND_TORSO_MARGIN = 0.2  # m from the torso's vertical axis that the hands keep out of
+ELBOW_TORSO_MARGIN = 0.25  # m for the elbows: keeps the upper arms off the chest
+POSTURE_WEIGHT = 0.02  # pull of the working arm towards READY_POSTURE (redundancy resolution)
+READY_POSTURE = "ready"
+BASE_WEIGHT = 1.0  # cost of base motion relative to arm motion (higher: the arm does more)
+FAILED_SOLVES = 10  # consecutive QP failures before a goal gives up
+CONTACT_LAG = 0.008  # m the measured hand lags its reference when something stops it (stop_on_contact)
+
+
+@dataclass
+class WholeBodyGoal:
+    """Tasks and limits for one motion, plus where the moving target is along its path."""
+
+    handle: MotionHandle
+    tasks: list[Task]
+    limits: list[Limit]
+    frozen: list[int]  # controlled-joint indices that must not move
+    start: float
+    duration: float
+    path: object = None  # ruckig.Trajectory over the path parameter s ∈ [0, 1]
+    frame_task: FrameTask | None = None
+    start_pose: pin.SE3 | None = None
+    target_pose: pin.SE3 | None = None
+    gaze_task: GazeTask | None = None
+    failures: int = 0
+    tolerance: tuple[float, float] = (POSITION_TOLERANCE, ORIENTATION_TOLERANCE)
+    extra: dict = field(default_factory=dict)
+
+
+class WholeBodyController:
+    """Runs one whole-body goal at a time over base, waist, arms and head."""
+
+    def __init__(
+        self,
+        config: RobotConfig,
+        base: BaseDriver,
+        joints: JointReferenceController,
+        joint_ranges: dict[str, tuple[float, float]],
+    ) -> None:
+        self.config = config
+        self.base = base
+        self.joints = joints
+        self.base_joints = [config.base.joints[axis] for axis in ("x", "y", "yaw")]
+        body_joints = [j for group in config.groups.values() for j in group]
+        self.names = self.base_joints + body_joints
+        self.kinematics = RobotKinematics(config, self.names)  # at the reference configuration
+        self.measured = RobotKinematics(config, self.names)  # at the encoder readings
+        self._body_index = joints.indices(body_joints)
+        lower = np.array([joint_ranges.get(j, (-np.inf, np.inf))[0] for j in self.names])
+        upper = np.array([joint_ranges.get(j, (-np.inf, np.inf))[1] for j in self.names])
+        limits = config.base.limits
+        max_velocity = np.array(
+            [limits.max_speed, limits.max_speed, limits.max_yaw_rate]
+            + [config.motion_limits(j).velocity for j in body_joints]
+        )
+        self.box_limits = [JointPositionLimit(lower, upper), VelocityLimit(max_velocity)]
+        margins = {g.grip_site: HAND_TORSO_MARGIN for g in config.grippers.values()}
+        margins.update({config.frames[f][1]: ELBOW_TORSO_MARGIN for f in ("left_elbow", "right_elbow") if f in config.frames})
+        self.torso_limit = TorsoMarginLimit(config.frames["torso"][1], margins)
+        self.goal: WholeBodyGoal | None = None
+        self.reference = np.zeros(len(self.names))
+        self.base_target = np.zeros(3)  # pose the base holds during and after a whole-body goal
+        self.solve_times: deque[float] = deque(maxlen=100_000)  # wall seconds per QP, for benchmarks
+        self.dt = 0.01
+
+    # ------------------------------------------------------------------ queries
+
+    def measured_positions(self) -> np.ndarray:
+        return np.concatenate([self.base.pose(), self.joints.io.positions()[self._body_index]])
+
+    def frame_pose(self, frame: str) -> pin.SE3:
+        """Where a frame is now, from the encoders."""
+        self.measured.update(self.measured_positions())
+        return self.measured.pose(frame).copy()
+
+    def hand_frame(self, side: str) -> str:
+        return self.config.grippers[side].grip_site
+
+    # ------------------------------------------------------------------ goals
+
+    def reach(
+        self,
+        side: str,
+        target: pin.SE3,
+        *,
+        speed: float = HAND_SPEED,
+        gaze: np.ndarray | None = None,
+        move_base: bool = True,
+        limits: list[Limit] | None = None,
+        tolerance: tuple[float, float] = (POSITION_TOLERANCE, ORIENTATION_TOLERANCE),
+        stop_on_contact: bool = False,
+    ) -> MotionHandle:
+        """Move ``side``'s hand to ``target`` in a straight line, the rest of the body helping.
+
+        With ``stop_on_contact`` the motion ends (successfully) as soon as the
+        measured hand lags its reference by ``CONTACT_LAG``: whatever it holds
+        has touched something, as when lowering an object onto a table.
+        """
+        self._begin()
+        frame = self.hand_frame(side)
+        self.kinematics.update(self.reference)
+        start = self.kinematics.pose(frame).copy()
+        distance = float(np.linalg.norm(target.translation - start.translation))
+        angle = float(np.linalg.norm(pin.log3(target.rotation @ start.rotation.T)))
+        # one path parameter for position and orientation: a straight line and a slerp, in step
+        scale = max(distance / max(speed, 1e-3), angle / HAND_TURN_RATE, 1e-3)
+        limits_s = (
+            np.array([1.0 / scale]),
+            np.array([HAND_ACCEL / max(distance, 0.05)]),
+            np.array([HAND_JERK / max(distance, 0.05)]),
+        )
+        path = plan_trajectory(np.zeros(1), np.zeros(1), np.zeros(1), np.ones(1), limits_s)
+        frame_task = FrameTask(frame, start.copy(), position_weight=1.0, orientation_weight=0.3, gain=0.6)
+        tasks: list[Task] = [frame_task]
+        other = [s for s in self.config.grippers if s != side]
+        held = {j: self.reference[self.names.index(j)] for s in other for j in self._arm_joints(s)}
+        tasks.append(PostureTask(held, weight=1.0, gain=0.5))
+        # redundancy: pull the working arm towards its "ready" posture and the waist straight
+        ready = self.config.postures.get(READY_POSTURE, {})
+        waist_and_arm = {j: ready.get(j, self.reference[self.names.index(j)]) for j in self._arm_joints(side)}
+        waist_and_arm.update({j: 0.0 for j in self.config.groups.get("waist", [])})
+        tasks.append(PostureTask(waist_and_arm, weight=POSTURE_WEIGHT, gain=0.05))
+        gaze_task = None
+        if gaze is not None:
+            gaze_task = GazeTask(self.config.frames["head_camera"][1], gaze)
+            tasks.append(gaze_task)
+        else:
+            tasks.append(PostureTask({j: self.reference[self.names.index(j)] for j in self._head_joints()}, 1.0))
+        tasks.append(DampingTask(self.base_joints, BASE_WEIGHT))
+        frozen = [] if move_base else [0, 1, 2]
+        handle = MotionHandle(f"reaching {distance * 100:.0f} cm with the {side} hand", on_cancel=self._cancelled)
+        self.goal = WholeBodyGoal(
+            handle,
+            tasks,
+            [self.torso_limit, *(limits or [])],
+            frozen,
+            self.joints.io.time,
+            path.duration,
+            path=path,
+            frame_task=frame_task,
+            start_pose=start,
+            target_pose=target,
+            gaze_task=gaze_task,
+            tolerance=tolerance,
+            extra={"stop_on_contact": stop_on_contact},
+        )
+        return handle
+
+    def look_at(self, point: np.ndarray) -> MotionHandle:
+        """Turn the head (only) so the camera looks at ``point``."""
+        self._begin()
+        camera = self.config.frames["head_camera"][1]
+        gaze = GazeTask(camera, np.asarray(point, dtype=float), weight=1.0, gain=0.3)
+        head = set(self._head_joints())
+        hold = {j: self.reference[i] for i, j in enumerate(self.names) if j not in head}
+        frozen = [i for i, j in enumerate(self.names) if j not in head]
+        handle = MotionHandle("turning the head", on_cancel=self._cancelled)
+        self.goal = WholeBodyGoal(handle, [gaze, PostureTask(hold, 1.0)], [], frozen, self.joints.io.time, 0.0)
+        self.goal.gaze_task = gaze
+        return handle
+
+    def cancel(self) -> None:
+        """Drop the goal; references stop where they are (the joint controllers then hold them)."""
+        if self.goal is not None:
+            self.goal.handle.fail("halted")
+            self.goal = None
+
+    # ------------------------------------------------------------------ control step
+
+    def step(self) -> None:
+        goal = self.goal
+        if goal is None:
+            return
+        elapsed = self.joints.io.time - goal.start
+        if goal.frame_task is not None and goal.path is not None:
+            s = float(goal.path.at_time(min(elapsed, goal.duration))[0][0])
+            goal.frame_task.target = pin.SE3.Interpolate(goal.start_pose, goal.target_pose, s)
+        # the base is velocity-controlled and gets pushed by the arms' reactions: solve at its measured pose
+        # (odometry) so the hand lands where it should in the world; the base itself tracks base_target
+        self.reference[:3] = self.base.pose()
+        self.kinematics.update(self.reference)
+        solution = solve_ik(self.kinematics, goal.tasks, self._box_limits(goal), goal.limits, self.dt)
+        self.solve_times.append(solution.solve_time)
+        goal.failures = 0 if solution.solved else goal.failures + 1
+        if goal.failures >= FAILED_SOLVES:
+            self._finish(goal, False, "whole-body QP has no solution: the target breaks a joint or safety limit")
+            return
+        self.reference = self.reference + solution.step
+        self.base_target = self.base_target + solution.step[:3]
+        velocity = solution.step / self.dt
+        self.base.track(self.base_target, velocity[:3])
+        self.joints.track(self._body_index, self.reference[3:], velocity[3:])
+        self._check_done(goal, elapsed)
+
+    # ------------------------------------------------------------------ internals
+
+    def _begin(self) -> None:
+        if self.goal is not None:
+            self.goal.handle.fail("pre-empted by a newer goal")
+            self.goal = None
+        self.reference = np.concatenate([self.base.pose(), self.joints.position[self._body_index]])
+        self.base_target = self.reference[:3].copy()
+
+    def _box_limits(self, goal: WholeBodyGoal) -> list:
+        if not goal.frozen:
+            return self.box_limits
+        return [*self.box_limits, _Frozen(goal.frozen, len(self.names))]
+
+    def _check_done(self, goal: WholeBodyGoal, elapsed: float) -> None:
+        if goal.extra.get("stop_on_contact") and goal.frame_task is not None:
+            self.measured.update(self.measured_positions())
+            frame = goal.frame_task.frame
+            lag = self.kinematics.pose(frame).translation - self.measured.pose(frame).translation
+            if np.linalg.norm(lag) > CONTACT_LAG:
+                self.reference = self.measured_positions()  # stop pressing
+                self.base_target = self.reference[:3].copy()
+                self._finish(goal, True, "stopped on contact")
+                return
+        if elapsed < goal.duration:
+            goal.handle.feedback = f"{goal.handle.description}: {elapsed:.1f}/{goal.duration:.1f} s"
+            return
+        self.measured.update(self.measured_positions())
+        errors = []
+        if goal.frame_task is not None:
+            error = goal.frame_task.error(self.measured)
+            errors += [float(np.linalg.norm(error[:3])) <= goal.tolerance[0]]
+            errors += [float(np.linalg.norm(error[3:])) <= goal.tolerance[1]]
+            goal.extra["position_error"] = float(np.linalg.norm(error[:3]))
+        if goal.gaze_task is not None and goal.frame_task is None:
+            errors.append(float(np.linalg.norm(goal.gaze_task.error(self.measured))) < 0.03)
+        if all(errors):
+            miss = goal.extra.get("position_error")
+            self._finish(goal, True, "arrived" if miss is None else f"arrived within {miss * 100:.1f} cm")
+        elif elapsed > goal.duration + SETTLE_TIMEOUT:
+            miss = goal.extra.get("position_error", 0.0)
+            self._finish(goal, False, f"hand stopped {miss * 100:.1f} cm from its target: blocked or out of reach")
+
+    def _finish(self, goal: WholeBodyGoal, success: bool, message: str) -> None:
+        self.goal = None
+        self.base.track(self.base_target, np.zeros(3))
+        if success:
+            goal.handle.succeed(message)
+        else:
+            goal.handle.fail(message)
+
+    def _cancelled(self, handle: MotionHandle) -> None:
+        if self.goal is not None and self.goal.handle is handle:
+            self.goal = None
+            self.base.brake()
+            self.joints.brake(self._body_index)
+
+    def _arm_joints(self, side: str) -> list[str]:
+        group = f"{side}_arm"
+        return list(self.config.groups.get(group, []))
+
+    def _head_joints(self) -> list[str]:
+        return list(self.config.groups.get("head", []))
+
+
+class _Frozen:
+    """Box limit that pins some joints: Δq = 0 for ``indices``."""
+
+    def __init__(self, indices: list[int], n: int) -> None:
+        self.mask = np.zeros(n, dtype=bool)
+        self.mask[indices] = True
+
+    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        bound = np.where(self.mask, 0.0, np.inf)
+        return -bound, bound
+
+
+def yaw_rotation(yaw: float) -> np.ndarray:
+    """Rotation about world z; a hand at this orientation points its fingers down, closing along x rotated by yaw."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

@@ -1,0 +1,92 @@
+"""The WorldModel: what the robot believes about objects and support surfaces.
+
+Skills and planners read objects and surfaces from here, never from the
+simulator. Beliefs are filled by a source (``declared.py`` seeds them from
+the world's declarations until RGB-D perception takes over) and by the
+robot's own actions: an object it holds moves with its hand, an object it
+put down is where it let go.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from bt_humanoid.errors import did_you_mean
+
+
+@dataclass
+class TrackedObject:
+    """One object as believed: pose of its centre, extents, and how sure we are."""
+
+    id: str  # unique, stable (e.g. the body name)
+    name: str  # what people call it ("red cube")
+    kind: str  # cube, bottle, mug, ball, ...
+    colour: str
+    position: np.ndarray  # centre, world frame (m)
+    yaw: float  # rad about world z
+    size: np.ndarray  # full extents (x, y, z) in the object's frame (m)
+    confidence: float = 1.0
+    last_seen: float = 0.0  # s of simulation time
+    keep_upright: bool = False
+    held_by: str | None = None  # gripper side while the robot holds it
+    grip_offset: float = 0.0  # m the grip site sits above the centre, while held
+
+    @property
+    def bottom(self) -> float:
+        return float(self.position[2] - self.size[2] / 2)
+
+    @property
+    def top(self) -> float:
+        return float(self.position[2] + self.size[2] / 2)
+
+
+@dataclass
+class SupportSurface:
+    """A horizontal surface objects can stand on: a rectangle at a height (map knowledge)."""
+
+    name: str
+    region: np.ndarray  # [[x_min, y_min], [x_max, y_max]]
+    height: float  # z of the top (m)
+
+    def contains(self, xy: np.ndarray, margin: float = 0.0) -> bool:
+        return bool(np.all(xy >= self.region[0] + margin) and np.all(xy <= self.region[1] - margin))
+
+
+@dataclass
+class WorldModel:
+    objects: dict[str, TrackedObject] = field(default_factory=dict)
+    surfaces: dict[str, SupportSurface] = field(default_factory=dict)
+    people: dict[str, np.ndarray] = field(default_factory=dict)  # name or alias → position (m)
+
+    def object(self, name: str) -> TrackedObject:
+        """An object by id or by name; a clear error listing what is known otherwise."""
+        if name in self.objects:
+            return self.objects[name]
+        for tracked in self.objects.values():
+            if tracked.name == name:
+                return tracked
+        known = [o.name for o in self.objects.values()]
+        raise KeyError(f"no object {name!r} in the world model; {did_you_mean(name, known)}")
+
+    def surface(self, name: str) -> SupportSurface:
+        if name not in self.surfaces:
+            raise KeyError(f"no surface {name!r}; {did_you_mean(name, list(self.surfaces))}")
+        return self.surfaces[name]
+
+    def person(self, name: str) -> np.ndarray:
+        if name not in self.people:
+            raise KeyError(f"no person {name!r}; {did_you_mean(name, list(self.people))}")
+        return self.people[name]
+
+    def surface_under(self, position: np.ndarray) -> SupportSurface | None:
+        """The highest surface below ``position`` whose rectangle contains it."""
+        below = [s for s in self.surfaces.values() if s.contains(position[:2]) and s.height <= position[2] + 0.01]
+        return max(below, key=lambda s: s.height) if below else None
+
+    def update(self, tracked: TrackedObject) -> None:
+        self.objects[tracked.id] = tracked
+
+    def held(self, side: str) -> TrackedObject | None:
+        return next((o for o in self.objects.values() if o.held_by == side), None)

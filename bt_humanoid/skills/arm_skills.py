@@ -1,0 +1,139 @@
+"""Skills that move the arms and head through the whole-body controller: look_at, reach, give."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+from pydantic import Field, model_validator
+
+from bt_humanoid.control.motion import MotionHandle
+from bt_humanoid.control.whole_body import yaw_rotation
+from bt_humanoid.errors import did_you_mean
+from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.manipulation_skills import Side, _check_object, _ManipulationSkill
+from bt_humanoid.skills.phased import PhaseFailure
+from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel
+
+GIVE_REACH = 0.5  # m ahead of the base, towards the person, where the hand holds the object out
+GIVE_HEIGHT = 1.0  # m
+
+
+class LookAtParams(StrictModel):
+    object: str | None = Field(None, description="an object from the world model")
+    point: tuple[float, float, float] | None = Field(None, description="[x, y, z] in the world (m)")
+
+    @model_validator(mode="after")
+    def _one_target(self) -> LookAtParams:
+        if (self.object is None) == (self.point is None):
+            raise ValueError("give exactly one of object or point")
+        return self
+
+
+@skill("look_at", "turn the head so the camera looks at an object or a point")
+class LookAt(_ManipulationSkill):
+    Params = LookAtParams
+
+    @classmethod
+    def check(cls, params: LookAtParams, context: CheckContext) -> list[tuple[str, str]]:
+        return _check_object(params.object, context) if params.object is not None else []
+
+    def phases(self):
+        return [("look", self._look)]
+
+    def _look(self) -> MotionHandle:
+        p: LookAtParams = self.params
+        point = self._object(p.object).position if p.object is not None else np.array(p.point)
+        return self.context.robot.whole_body.look_at(point)
+
+
+class ReachParams(StrictModel):
+    position: tuple[float, float, float] = Field(description="[x, y, z] of the grip point (m)")
+    yaw: float = Field(0.0, ge=-360, le=360, description="hand yaw (degrees), fingers pointing down")
+    relative: bool = Field(False, description="position and yaw are in the base frame instead of the world")
+    side: Side = Field("right", description="which hand")
+    move_base: bool = Field(True, description="let the base help (it stays where it is if false)")
+
+
+@skill("reach", "move a hand to a pose with the whole body (base, waist, arm, head looking at it)")
+class Reach(_ManipulationSkill):
+    Params = ReachParams
+
+    def phases(self):
+        return [("reach", self._reach)]
+
+    def _reach(self) -> MotionHandle:
+        p: ReachParams = self.params
+        position, yaw = np.array(p.position, dtype=float), math.radians(p.yaw)
+        if p.relative:
+            x, y, base_yaw = self.context.robot.base.pose()
+            position = np.array([x, y, 0.0]) + yaw_rotation(base_yaw) @ position
+            yaw += base_yaw
+        target = pin.SE3(yaw_rotation(yaw), position)
+        return self.context.robot.whole_body.reach(p.side, target, gaze=position, move_base=p.move_base)
+
+
+class GiveParams(StrictModel):
+    to: str = Field("person", description="a person of the world (name or alias)")
+    side: Side = Field("right", description="the hand holding the object")
+    timeout: float = Field(10.0, gt=0, le=120, description="s to wait for the person to take it before letting go")
+    release_key: str = Field("release", description="blackboard key that, once true, means 'let go now'")
+
+
+@skill("give", "hold the object out to a person; let go when asked (blackboard) or after a timeout")
+class Give(_ManipulationSkill):
+    Params = GiveParams
+
+    @classmethod
+    def check(cls, params: GiveParams, context: CheckContext) -> list[tuple[str, str]]:
+        names = [n for name, person in context.world.people.items() for n in (name, *person.aliases)]
+        if params.to in names:
+            return []
+        return [("to", f"unknown person '{params.to}' ({did_you_mean(params.to, names)})")]
+
+    def phases(self):
+        return [("hold out", self._hold_out), ("wait", self._wait), ("let go", self._let_go)]
+
+    def _hold_out(self) -> MotionHandle:
+        self.held = self.context.world_model.held(self.params.side)
+        if self.held is None:
+            raise PhaseFailure(f"the {self.params.side} hand holds nothing to give")
+        x, y, _ = self.context.robot.base.pose()
+        person = self.context.world_model.person(self.params.to)
+        direction = person[:2] - np.array([x, y])
+        heading = math.atan2(direction[1], direction[0])
+        distance = float(np.linalg.norm(direction))
+        reach = min(GIVE_REACH, max(distance - 0.3, 0.3))
+        position = np.array([x + reach * math.cos(heading), y + reach * math.sin(heading), GIVE_HEIGHT])
+        target = pin.SE3(yaw_rotation(heading), position)
+        return self.context.robot.whole_body.reach(self.params.side, target, gaze=person, move_base=False)
+
+    def _wait(self) -> MotionHandle:
+        handle = MotionHandle("holding it out")
+        started = self.context.clock()
+        blackboard = self.context.blackboard
+
+        def poll() -> None:
+            if blackboard.values.get(self.params.release_key):
+                handle.succeed("asked to let go")
+            elif self.context.clock() - started > self.params.timeout:
+                handle.succeed(f"let go after {self.params.timeout:.0f} s")
+            else:
+                handle.feedback = f"holding it out for {self.context.clock() - started:.0f} s"
+
+        handle.poll = poll  # type: ignore[attr-defined]
+        self._waiting = handle
+        return handle
+
+    def poll(self):
+        waiting = getattr(self, "_waiting", None)
+        if waiting is not None and waiting is self.motion:
+            waiting.poll()
+        return super().poll()
+
+    def _let_go(self) -> MotionHandle:
+        self.held.held_by = None
+        self.held.confidence = 0.0  # handed over: no longer on any surface we know
+        return self.context.robot.grippers.command(self.params.side, "open")

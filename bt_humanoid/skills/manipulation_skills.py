@@ -1,0 +1,365 @@
+"""Skills that handle objects: stand near, grasp, put, release, give.
+
+All of them read objects and surfaces from the WorldModel (the robot's
+belief), never from the simulator. The pick and place behaviours in
+behaviors/ compose them with recovery.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+import numpy as np
+import pinocchio as pin
+from pydantic import Field
+
+from bt_humanoid.control.grasping import LIFT_HEIGHT, GraspError, plan_grasp
+from bt_humanoid.control.motion import MotionHandle
+from bt_humanoid.control.stance import StanceError, stance_for
+from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Limit
+from bt_humanoid.control.whole_body import yaw_rotation
+from bt_humanoid.errors import did_you_mean
+from bt_humanoid.perception.world_model import SupportSurface, TrackedObject
+from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.params import is_reference
+from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
+from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel
+
+Side = Literal["left", "right"]
+APPROACH_CLEARANCE = 0.06  # m the hand (or what it holds) keeps above a surface while moving over it
+KEEPOUT_MARGIN = 0.03  # m added to the footprint radius when the base moves during a reach
+DESCEND_SPEED = 0.1  # m/s for the last few centimetres to a grasp or a placement
+RELEASE_GAP = 0.005  # m between a placed object's bottom and the surface when the gripper opens
+GRASP_WIDTH_TOLERANCE = 0.015  # m: a closed width further than this from the object's size is "something else"
+TUCKED_POSTURE = "tucked"  # robot.yaml posture for the idle arm near furniture
+CARRY_FORWARD = 0.3  # m ahead of the base centre where a held object is carried: behind the bumper line
+CARRY_SIDE = 0.2  # m to the side of the working hand
+CARRY_HEIGHT = 0.95  # m above the floor, at least
+CARRY_CLEARANCE = 0.04  # m above the highest known surface for the bottom of what is carried
+MAX_CARRY_HEIGHT = 1.15  # m: the arm's comfortable limit
+CARRY_TOLERANCE = (0.03, 0.2)  # m, rad: the carry pose needs no precision
+
+
+def _check_object(name: str, context: CheckContext) -> list[tuple[str, str]]:
+    if is_reference(name) or name in context.world.objects:
+        return []
+    return [("object", f"unknown object '{name}' ({did_you_mean(name, context.world.objects)})")]
+
+
+def _check_surface(name: str, context: CheckContext, parameter: str) -> list[tuple[str, str]]:
+    if is_reference(name) or name in context.world.surfaces:
+        return []
+    return [(parameter, f"unknown surface '{name}' ({did_you_mean(name, context.world.surfaces)})")]
+
+
+class _ManipulationSkill(PhasedSkill):
+    """Shared helpers: belief look-ups with clear errors, reach limits, the carry pose."""
+
+    def _object(self, name: str) -> TrackedObject:
+        try:
+            return self.context.world_model.object(name)
+        except KeyError as error:
+            raise PhaseFailure(error.args[0]) from None
+
+    def _surface(self, name: str) -> SupportSurface:
+        try:
+            return self.context.world_model.surface(name)
+        except KeyError as error:
+            raise PhaseFailure(error.args[0]) from None
+
+    def _keepout(self, surface: SupportSurface) -> Limit:
+        radius = self.context.robot_config.base.footprint_radius + KEEPOUT_MARGIN
+        return BaseKeepoutLimit(self.context.robot_config.frames["base"][1], surface.region, radius)
+
+    def _hand_yaw(self, side: str) -> float:
+        rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
+        return math.atan2(rotation[1, 0], rotation[0, 0])
+
+    def _carry(self, side: str, surfaces: list[SupportSurface]) -> MotionHandle:
+        """Bring the hand in front of the body, high enough to carry what it holds past furniture."""
+        x, y, yaw = self.context.robot.base.pose()
+        lateral = -CARRY_SIDE if side == "right" else CARRY_SIDE
+        forward = np.array([math.cos(yaw), math.sin(yaw)])
+        left = np.array([-math.sin(yaw), math.cos(yaw)])
+        xy = np.array([x, y]) + CARRY_FORWARD * forward + lateral * left
+        # high enough that what hangs below the hand clears every known surface on the way
+        held = self.context.world_model.held(side)
+        below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
+        highest = max((s.height for s in self.context.world_model.surfaces.values()), default=0.0)
+        height = min(max(CARRY_HEIGHT, highest + below_hand + CARRY_CLEARANCE), MAX_CARRY_HEIGHT)
+        # keep the hand's yaw as it is: carrying needs no precision, and turning the wrist could drop things
+        target = pin.SE3(yaw_rotation(self._hand_yaw(side)), np.array([*xy, height]))
+        return self.context.robot.whole_body.reach(
+            side,
+            target,
+            move_base=False,
+            limits=[self._clearance(side, s, 0.0) for s in surfaces],
+            tolerance=CARRY_TOLERANCE,
+        )
+
+    def _clearance(self, side: str, surface: SupportSurface, below_hand: float) -> Limit:
+        """Keep the hand high enough over ``surface`` that ``below_hand`` metres beneath it stay clear."""
+        frame = self.context.robot.whole_body.hand_frame(side)
+        return ClearanceLimit(frame, surface.height + below_hand + APPROACH_CLEARANCE, surface.region)
+
+
+# --------------------------------------------------------------------------- stand_near
+
+
+class StandNearParams(StrictModel):
+    object: str | None = Field(None, description="an object to work on (from the world model)")
+    surface: str | None = Field(None, description="a support surface to work on, at `at` or its nearest spot")
+    at: tuple[float, float] | None = Field(None, description="[x, y] spot on the surface (m, world)")
+    side: Side = Field("right", description="the hand that will work")
+    max_speed: float = Field(0.3, gt=0, le=0.8, description="m/s cap for this short, final approach")
+
+
+@skill("stand_near", "drive (straight, short) to a stance from which one hand reaches an object or a surface spot")
+class StandNear(_ManipulationSkill):
+    Params = StandNearParams
+
+    @classmethod
+    def check(cls, params: StandNearParams, context: CheckContext) -> list[tuple[str, str]]:
+        if (params.object is None) == (params.surface is None):
+            return [("object", "give exactly one of object or surface")]
+        if params.object is not None:
+            return _check_object(params.object, context)
+        return _check_surface(params.surface, context, "surface")
+
+    def phases(self):
+        return [("tuck the other arm", self._tuck), ("stance", self._drive)]
+
+    def _tuck(self) -> MotionHandle:
+        """Fold the idle arm inside the footprint, where no furniture edge can catch it."""
+        config = self.context.robot_config
+        other = "left" if self.params.side == "right" else "right"
+        joints = config.groups.get(f"{other}_arm", [])
+        tucked = config.postures.get(TUCKED_POSTURE, {})
+        return self.context.robot.joints.move({j: tucked[j] for j in joints if j in tucked})
+
+    def _drive(self) -> MotionHandle:
+        p: StandNearParams = self.params
+        belief = self.context.world_model
+        if p.object is not None:
+            obj = self._object(p.object)
+            surface = belief.surface_under(obj.position) if obj.held_by is None else None
+            if surface is None:
+                raise PhaseFailure(f"{obj.name} is not on a known surface (held, or fallen?)")
+            spot = obj.position[:2]
+        else:
+            surface = self._surface(p.surface)
+            spot = np.array(p.at) if p.at is not None else surface.region.mean(axis=0)
+        config = self.context.robot_config
+        try:
+            x, y, yaw = stance_for(
+                spot, surface, p.side, config.base.footprint_radius, np.array(self.context.world.bounds)
+            )
+        except StanceError as error:
+            raise PhaseFailure(str(error)) from None
+        speed = min(p.max_speed, self.context.max_base_speed)
+        return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
+
+
+# --------------------------------------------------------------------------- grasp
+
+
+class GraspParams(StrictModel):
+    object: str = Field(description="the object to pick up (from the world model)")
+    side: Side = Field("right", description="which hand")
+
+
+@skill("grasp", "pick up an object within reach: pre-grasp above it, descend, close, lift, verify, carry")
+class Grasp(_ManipulationSkill):
+    Params = GraspParams
+
+    @classmethod
+    def check(cls, params: GraspParams, context: CheckContext) -> list[tuple[str, str]]:
+        return _check_object(params.object, context)
+
+    def phases(self):
+        return [
+            ("plan", self._plan),
+            ("pre-grasp", self._pre_grasp),
+            ("descend", self._descend),
+            ("close", self._close),
+            ("check grasp", self._check_grasp),
+            ("lift", self._lift),
+            ("verify", self._verify),
+            ("carry", lambda: self._carry(self.params.side, [self.surface])),
+        ]
+
+    def _plan(self) -> None:
+        side = self.params.side
+        held = self.context.world_model.held(side)
+        if held is not None:
+            raise PhaseFailure(f"the {side} hand already holds the {held.name}")
+        self.target = self._object(self.params.object)
+        surface = self.context.world_model.surface_under(self.target.position)
+        if surface is None:
+            raise PhaseFailure(f"{self.target.name} is not on a known surface")
+        self.surface = surface
+        try:
+            self.grasp = plan_grasp(self.target, surface.height, self._hand_yaw(side))
+        except GraspError as error:
+            raise PhaseFailure(str(error)) from None
+
+    def _pose(self, position: np.ndarray) -> pin.SE3:
+        return pin.SE3(yaw_rotation(self.grasp.yaw), position)
+
+    def _pre_grasp(self) -> MotionHandle:
+        robot = self.context.robot
+        robot.grippers.command(self.params.side, "open")  # opens while the hand travels
+        limits = [self._keepout(self.surface), self._clearance(self.params.side, self.surface, 0.0)]
+        return robot.whole_body.reach(
+            self.params.side, self._pose(self.grasp.pre_grasp), gaze=self.target.position, limits=limits
+        )
+
+    def _descend(self) -> MotionHandle:
+        return self.context.robot.whole_body.reach(
+            self.params.side,
+            self._pose(self.grasp.position),
+            speed=DESCEND_SPEED,
+            gaze=self.target.position,
+            limits=[self._keepout(self.surface)],
+            tolerance=(0.008, 0.1),
+        )
+
+    def _close(self) -> MotionHandle:
+        return self.context.robot.grippers.grasp(self.params.side)
+
+    def _check_grasp(self) -> None:
+        width = self.context.robot.grippers.width(self.params.side)
+        if abs(width - self.grasp.width) > GRASP_WIDTH_TOLERANCE:
+            self.context.robot.grippers.command(self.params.side, "open")
+            raise PhaseFailure(
+                f"closed {width * 100:.1f} cm wide where the {self.target.name} is {self.grasp.width * 100:.1f} cm: "
+                "not holding it"
+            )
+        self.grip_width = width
+        self.target.held_by = self.params.side
+        self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
+
+    def _lift(self) -> MotionHandle:
+        return self.context.robot.whole_body.reach(
+            self.params.side, self._pose(self.grasp.position + [0, 0, LIFT_HEIGHT]), speed=DESCEND_SPEED
+        )
+
+    def _verify(self) -> None:
+        grippers = self.context.robot.grippers
+        width = grippers.width(self.params.side)
+        if not grippers.holding(self.params.side) or abs(width - self.grip_width) > 0.01:
+            self.target.held_by = None
+            self.target.confidence = 0.0  # where it went is unknown until it is seen again
+            raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
+
+    def on_failure(self) -> None:
+        # a failed grasp leaves the hand open and above the object, ready for another attempt
+        if self.phase in ("descend", "close"):
+            self.context.robot.grippers.command(self.params.side, "open")
+
+
+# --------------------------------------------------------------------------- put
+
+
+class PutParams(StrictModel):
+    on: str = Field(description="the support surface to put the held object on")
+    at: tuple[float, float] | None = Field(None, description="[x, y] spot (m, world); default: straight ahead")
+    side: Side = Field("right", description="the hand holding the object")
+
+
+@skill("put", "put the held object down on a surface: above the spot, lower until contact, release, retreat")
+class Put(_ManipulationSkill):
+    Params = PutParams
+
+    @classmethod
+    def check(cls, params: PutParams, context: CheckContext) -> list[tuple[str, str]]:
+        return _check_surface(params.on, context, "on")
+
+    def phases(self):
+        return [
+            ("plan", self._plan),
+            ("above the spot", self._above),
+            ("lower", self._lower),
+            ("release", self._release),
+            ("retreat", self._retreat),
+            ("carry", lambda: self._carry(self.params.side, [self.surface])),
+        ]
+
+    def _plan(self) -> None:
+        side = self.params.side
+        self.held = self.context.world_model.held(side)
+        if self.held is None:
+            raise PhaseFailure(f"the {side} hand holds nothing")
+        self.surface = self._surface(self.params.on)
+        whole_body = self.context.robot.whole_body
+        hand = whole_body.frame_pose(whole_body.hand_frame(side))
+        if self.params.at is not None:
+            spot = np.array(self.params.at, dtype=float)
+        else:
+            spot = self._spot_ahead(hand.translation[:2])
+        if not self.surface.contains(spot, margin=0.05):
+            raise PhaseFailure(f"spot ({spot[0]:.2f}, {spot[1]:.2f}) is not on the {self.surface.name}")
+        # the hand sits this far above the object's bottom (as grasped)
+        self.below_hand = self.held.grip_offset + float(self.held.size[2]) / 2
+        release_z = self.surface.height + RELEASE_GAP + self.below_hand
+        self.rotation = hand.rotation.copy()
+        self.release = np.array([spot[0], spot[1], release_z])
+
+    def _spot_ahead(self, hand_xy: np.ndarray) -> np.ndarray:
+        """The nearest point of the surface to the hand, 12 cm in from the edge."""
+        region = self.surface.region
+        return np.clip(hand_xy, region[0] + 0.12, region[1] - 0.12)
+
+    def _above(self) -> MotionHandle:
+        limits = [self._keepout(self.surface), self._clearance(self.params.side, self.surface, self.below_hand)]
+        target = pin.SE3(self.rotation, self.release + [0, 0, APPROACH_CLEARANCE + 0.02])
+        return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
+
+    def _lower(self) -> MotionHandle:
+        target = pin.SE3(self.rotation, self.release)
+        return self.context.robot.whole_body.reach(
+            self.params.side,
+            target,
+            speed=DESCEND_SPEED / 2,
+            gaze=self.release,
+            limits=[self._keepout(self.surface)],
+            stop_on_contact=True,
+        )
+
+    def _release(self) -> MotionHandle:
+        hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
+        self.held.held_by = None
+        self.held.position = np.array([hand.translation[0], hand.translation[1], self.surface.height])
+        self.held.position[2] += self.held.size[2] / 2
+        self.held.last_seen = self.context.clock()
+        return self.context.robot.grippers.command(self.params.side, "open")
+
+    def _retreat(self) -> MotionHandle:
+        target = pin.SE3(self.rotation, self.release + [0, 0, LIFT_HEIGHT])
+        return self.context.robot.whole_body.reach(
+            self.params.side, target, speed=DESCEND_SPEED, move_base=False, tolerance=CARRY_TOLERANCE
+        )
+
+
+# --------------------------------------------------------------------------- release, look_at, give
+
+
+class ReleaseParams(StrictModel):
+    side: Side = Field("right", description="which hand opens")
+
+
+@skill("release", "open a hand and let go of what it holds, wherever it is")
+class Release(_ManipulationSkill):
+    Params = ReleaseParams
+
+    def phases(self):
+        return [("open", self._open)]
+
+    def _open(self) -> MotionHandle:
+        held = self.context.world_model.held(self.params.side)
+        if held is not None:
+            held.held_by = None
+            held.confidence = 0.0  # it falls somewhere: unknown until seen
+        return self.context.robot.grippers.command(self.params.side, "open")

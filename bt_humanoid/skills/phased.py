@@ -1,0 +1,71 @@
+"""Skills made of phases run one after another (pre-grasp, descend, close, lift, ...).
+
+Each phase sends a goal and returns its handle (or None when it is done at
+once); the skill moves on when the handle succeeds and fails with the phase
+named when it fails, so the event log says exactly what went wrong where.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from py_trees.common import Status
+
+from bt_humanoid.control.motion import MotionHandle, MotionStatus
+from bt_humanoid.skills.base import Skill
+
+Phase = tuple[str, Callable[[], MotionHandle | None]]
+
+
+class PhaseFailure(ValueError):
+    """Raised by a phase that finds it cannot go on (nothing grasped, object slipped)."""
+
+
+class PhasedSkill(Skill):
+    """Runs ``phases()`` in order; feedback is "phase: progress"."""
+
+    def phases(self) -> list[Phase]:
+        raise NotImplementedError
+
+    def start(self) -> MotionHandle | None:
+        self._phases = self.phases()
+        self._index = -1
+        self._phase_failure: str | None = None
+        return self._next()
+
+    def _next(self) -> MotionHandle | None:
+        while self._index + 1 < len(self._phases):
+            self._index += 1
+            name, begin = self._phases[self._index]
+            try:
+                handle = begin()
+            except PhaseFailure as failure:
+                self._phase_failure = f"{name}: {failure}"
+                return None
+            if handle is not None:
+                return handle
+        return None
+
+    @property
+    def phase(self) -> str:
+        return self._phases[self._index][0] if 0 <= self._index < len(self._phases) else "done"
+
+    def poll(self) -> Status:
+        while True:
+            if self._phase_failure is not None:
+                self.feedback_message = self._phase_failure
+                return Status.FAILURE
+            if self.motion is None:
+                self.feedback_message = "done"
+                return Status.SUCCESS
+            if self.motion.status is MotionStatus.RUNNING:
+                self.feedback_message = f"{self.phase}: {self.motion.feedback}"
+                return Status.RUNNING
+            if self.motion.status is not MotionStatus.SUCCEEDED:
+                self.feedback_message = f"{self.phase}: {self.motion.result}"
+                self.on_failure()
+                return Status.FAILURE
+            self.motion = self._next()
+
+    def on_failure(self) -> None:
+        """Called once when a phase's motion fails; leave the robot safe (e.g. open an empty gripper)."""
