@@ -25,6 +25,10 @@ PRE_GRASP_HEIGHT = 0.1  # m above the grasp: the hand comes down from here
 LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
 MAX_OPENING = 0.1  # m between the pads when the gripper is fully open
 
+# hand yaw relative to the base heading that suits each arm best for top-down grasps: the pads face left
+# and right (as a person's thumb and fingers do), which keeps the wrist far from its pitch limits
+NATURAL_YAW = {"right": -math.pi / 2, "left": math.pi / 2}
+
 SYMMETRY = {"cube": math.pi / 2, "box": math.pi / 2, "mug": math.pi, "bottle": 0.0, "can": 0.0, "ball": 0.0}
 
 
@@ -47,8 +51,13 @@ class GraspError(ValueError):
     """The object cannot be grasped by this hand (too wide, unknown shape)."""
 
 
+def natural_hand_yaw(side: str, base_yaw: float) -> float:
+    """The hand yaw (world) that suits ``side``'s arm when the base faces ``base_yaw``."""
+    return float(wrap_angle(base_yaw + NATURAL_YAW[side]))
+
+
 def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float) -> Grasp:
-    """A top-down grasp of ``obj`` standing on a surface at ``support_height``."""
+    """A top-down grasp of ``obj`` standing on a surface at ``support_height``, hand yaw nearest ``hand_yaw``."""
     if obj.kind not in SYMMETRY:
         raise GraspError(f"no grasp for objects of kind {obj.kind!r}; graspable kinds: {', '.join(SYMMETRY)}")
     # mugs: close across the body, at right angles to the handle (which points along the mug's x)

@@ -28,8 +28,12 @@ def stance_for(
     side: str,
     footprint_radius: float,
     bounds: np.ndarray,
+    robot_xy: np.ndarray,
 ) -> tuple[float, float, float]:
-    """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``."""
+    """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``.
+
+    Of the edges that reach the spot, the one whose stance is nearest the robot wins.
+    """
     (x0, y0), (x1, y1) = surface.region
     x, y = float(spot[0]), float(spot[1])
     standoff = footprint_radius + EDGE_CLEARANCE
@@ -50,7 +54,11 @@ def stance_for(
             options.append((depth, stance, yaw))
     if not options:
         raise StanceError(f"no room to stand beside the {surface.name}")
-    depth, stance, yaw = min(options, key=lambda option: option[0])
+    reachable = [option for option in options if option[0] <= MAX_DEPTH]
+    if reachable:
+        depth, stance, yaw = min(reachable, key=lambda option: float(np.linalg.norm(option[1] - robot_xy)))
+    else:
+        depth, stance, yaw = min(options, key=lambda option: option[0])
     if depth > MAX_DEPTH:
         raise StanceError(
             f"spot ({x:.2f}, {y:.2f}) is {depth:.2f} m behind the nearest free edge of the {surface.name}; "

@@ -89,7 +89,9 @@ class WholeBodyController:
         )
         self.box_limits = [JointPositionLimit(lower, upper), VelocityLimit(max_velocity)]
         margins = {g.grip_site: HAND_TORSO_MARGIN for g in config.grippers.values()}
-        margins.update({config.frames[f][1]: ELBOW_TORSO_MARGIN for f in ("left_elbow", "right_elbow") if f in config.frames})
+        margins.update(
+            {config.frames[f][1]: ELBOW_TORSO_MARGIN for f in ("left_elbow", "right_elbow") if f in config.frames}
+        )
         self.torso_limit = TorsoMarginLimit(config.frames["torso"][1], margins)
         self.goal: WholeBodyGoal | None = None
         self.reference = np.zeros(len(self.names))

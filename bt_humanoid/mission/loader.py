@@ -263,6 +263,8 @@ class MissionLoader:
                 names = [(target, places)]
             elif kind in ("in_hand", "upright"):
                 names = [(data[kind], objects)]
+            elif kind == "near":
+                names = [(data["near"]["object"], objects)]
             for name, valid in names:
                 if name not in valid:
                     raise UserError(f"success: unknown name '{name}'", where=where, hint=did_you_mean(name, valid))

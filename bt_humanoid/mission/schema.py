@@ -59,12 +59,22 @@ class UprightCondition(StrictModel):
     upright: str = Field(description="the object stands upright (within 15°)")
 
 
+class NearSpot(StrictModel):
+    object: str
+    position: tuple[float, float] = Field(description="[x, y] in the world (m)")
+    within: float = Field(0.03, gt=0, description="metres, horizontal distance")
+
+
+class NearCondition(StrictModel):
+    near: NearSpot = Field(description="the object's centre lies within `within` of a spot (horizontally)")
+
+
 class GripperCondition(StrictModel):
     gripper: tuple[Literal["left", "right"], Literal["open", "closed"]] = Field(description="[side, state]")
 
 
-SuccessCondition = OnCondition | AtCondition | InHandCondition | UprightCondition | GripperCondition
-CONDITION_KINDS = ("on", "at", "in_hand", "upright", "gripper")
+SuccessCondition = OnCondition | AtCondition | InHandCondition | UprightCondition | NearCondition | GripperCondition
+CONDITION_KINDS = ("on", "at", "in_hand", "upright", "near", "gripper")
 
 
 class MissionHeader(StrictModel):

@@ -10,6 +10,7 @@ from bt_humanoid.mission.schema import (
     AtCondition,
     GripperCondition,
     InHandCondition,
+    NearCondition,
     OnCondition,
     SuccessCondition,
     UprightCondition,
@@ -47,6 +48,15 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
     if isinstance(condition, UprightCondition):
         holds = truth.upright(condition.upright)
         return ConditionResult(f"{condition.upright} upright", holds, "upright" if holds else "tipped over")
+    if isinstance(condition, NearCondition):
+        spot = condition.near
+        position = truth.object_position(spot.object)
+        distance = math.hypot(position[0] - spot.position[0], position[1] - spot.position[1])
+        return ConditionResult(
+            f"{spot.object} within {spot.within * 100:.0f} cm of ({spot.position[0]:.2f}, {spot.position[1]:.2f})",
+            distance <= spot.within,
+            f"{distance * 100:.1f} cm away",
+        )
     if isinstance(condition, GripperCondition):
         side, state = condition.gripper
         width = truth.gripper_width(side)

@@ -14,11 +14,11 @@ import numpy as np
 import pinocchio as pin
 from pydantic import Field
 
-from bt_humanoid.control.grasping import LIFT_HEIGHT, GraspError, plan_grasp
+from bt_humanoid.control.grasping import LIFT_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Limit
-from bt_humanoid.control.whole_body import yaw_rotation
+from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.errors import did_you_mean
 from bt_humanoid.perception.world_model import SupportSurface, TrackedObject
 from bt_humanoid.skills.context import CheckContext
@@ -77,6 +77,9 @@ class _ManipulationSkill(PhasedSkill):
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
         return math.atan2(rotation[1, 0], rotation[0, 0])
 
+    def _natural_yaw(self, side: str) -> float:
+        return natural_hand_yaw(side, float(self.context.robot.base.pose()[2]))
+
     def _carry(self, side: str, surfaces: list[SupportSurface]) -> MotionHandle:
         """Bring the hand in front of the body, high enough to carry what it holds past furniture."""
         x, y, yaw = self.context.robot.base.pose()
@@ -89,8 +92,9 @@ class _ManipulationSkill(PhasedSkill):
         below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
         highest = max((s.height for s in self.context.world_model.surfaces.values()), default=0.0)
         height = min(max(CARRY_HEIGHT, highest + below_hand + CARRY_CLEARANCE), MAX_CARRY_HEIGHT)
-        # keep the hand's yaw as it is: carrying needs no precision, and turning the wrist could drop things
-        target = pin.SE3(yaw_rotation(self._hand_yaw(side)), np.array([*xy, height]))
+        # an empty hand turns to its natural yaw; a full one keeps its yaw (as grasped) so nothing swings
+        hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(side, yaw)
+        target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, height]))
         return self.context.robot.whole_body.reach(
             side,
             target,
@@ -129,7 +133,20 @@ class StandNear(_ManipulationSkill):
         return _check_surface(params.surface, context, "surface")
 
     def phases(self):
-        return [("tuck the other arm", self._tuck), ("stance", self._drive)]
+        return [
+            ("tuck the other arm", self._tuck),
+            ("raise the arm", self._raise_arm),
+            ("stance", self._drive),
+        ]
+
+    def _raise_arm(self) -> MotionHandle | None:
+        """An empty working arm goes to the ready posture (a good start for reaches); a full one stays as carried."""
+        if self.context.world_model.held(self.params.side) is not None:
+            return None
+        config = self.context.robot_config
+        joints = config.groups.get(f"{self.params.side}_arm", [])
+        ready = config.postures.get(READY_POSTURE, {})
+        return self.context.robot.joints.move({j: ready[j] for j in joints if j in ready})
 
     def _tuck(self) -> MotionHandle:
         """Fold the idle arm inside the footprint, where no furniture edge can catch it."""
@@ -154,7 +171,12 @@ class StandNear(_ManipulationSkill):
         config = self.context.robot_config
         try:
             x, y, yaw = stance_for(
-                spot, surface, p.side, config.base.footprint_radius, np.array(self.context.world.bounds)
+                spot,
+                surface,
+                p.side,
+                config.base.footprint_radius,
+                np.array(self.context.world.bounds),
+                self.context.robot.base.pose()[:2],
             )
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
@@ -181,6 +203,7 @@ class Grasp(_ManipulationSkill):
     def phases(self):
         return [
             ("plan", self._plan),
+            ("raise", self._raise),
             ("pre-grasp", self._pre_grasp),
             ("descend", self._descend),
             ("close", self._close),
@@ -207,6 +230,16 @@ class Grasp(_ManipulationSkill):
 
     def _pose(self, position: np.ndarray) -> pin.SE3:
         return pin.SE3(yaw_rotation(self.grasp.yaw), position)
+
+    def _raise(self) -> MotionHandle | None:
+        """Lift the hand straight up to the pre-grasp height first, so it clears the surface's edge."""
+        whole_body = self.context.robot.whole_body
+        hand = whole_body.frame_pose(whole_body.hand_frame(self.params.side)).translation
+        if hand[2] >= self.grasp.pre_grasp[2] - 0.02:
+            return None
+        self.context.robot.grippers.command(self.params.side, "open")
+        target = np.array([hand[0], hand[1], self.grasp.pre_grasp[2]])
+        return whole_body.reach(self.params.side, self._pose(target), move_base=False, tolerance=CARRY_TOLERANCE)
 
     def _pre_grasp(self) -> MotionHandle:
         robot = self.context.robot

@@ -43,7 +43,9 @@ def _add_camera_frames(model: pin.Model, config: RobotConfig) -> None:
         rotation = np.zeros(9)
         mujoco.mju_quat2Mat(rotation, mj_model.cam_quat[i])
         placement = model.frames[parent].placement * pin.SE3(rotation.reshape(3, 3), mj_model.cam_pos[i].copy())
-        model.addFrame(pin.Frame(camera.name, model.frames[parent].parentJoint, parent, placement, pin.FrameType.OP_FRAME))
+        model.addFrame(
+            pin.Frame(camera.name, model.frames[parent].parentJoint, parent, placement, pin.FrameType.OP_FRAME)
+        )
 
 
 class RobotKinematics:

@@ -48,7 +48,9 @@ def _conic(solver: str, n: int, m: int) -> casadi.Function:
     key = (solver, n, m)
     if key not in _solvers:
         pattern = {"h": casadi.Sparsity.dense(n, n), "a": casadi.Sparsity.dense(m, n)}
-        _solvers[key] = casadi.conic("wbc", solver, pattern, _SOLVER_OPTIONS.get(solver, {}))
+        # an infeasible step is reported through stats()["success"], not raised
+        options = {"error_on_fail": False, **_SOLVER_OPTIONS.get(solver, {})}
+        _solvers[key] = casadi.conic("wbc", solver, pattern, options)
     return _solvers[key]
 
 
