@@ -11,6 +11,8 @@ from bt_humanoid.testing.scenario import build_run
 
 MISSIONS = sorted((project_root() / "missions").glob("*.yaml"))
 BEHAVIORS = sorted(BehaviorLibrary().behaviors)
+# a valid value for every required behaviour parameter used in this repo
+SAMPLE_ARGS = {"place": "table", "object": "red cube", "surface": "counter", "x": 8.4, "y": 2.8}
 
 
 def assert_fully_wrapped(root: Behaviour) -> int:
@@ -39,7 +41,7 @@ def test_every_mission_is_fully_wrapped(mission):
 @pytest.mark.parametrize("behavior", BEHAVIORS)
 def test_every_behaviour_is_fully_wrapped(behavior):
     args = _default_args(BehaviorLibrary().behaviors[behavior])
-    args = {k: "table" for k in args}  # required behaviour parameters in this repo are place names
+    args = {k: SAMPLE_ARGS[k] for k in args}
     run = build_run({"mission": f"wrap {behavior}", "tree": {behavior: args}})
     assert assert_fully_wrapped(run.compiled.root) > 1
 

@@ -276,7 +276,7 @@ class Grasp(_ManipulationSkill):
 
     def _lift(self) -> MotionHandle:
         return self.context.robot.whole_body.reach(
-            self.params.side, self._pose(self.grasp.position + [0, 0, LIFT_HEIGHT]), speed=DESCEND_SPEED
+            self.params.side, self._pose(self.grasp.position + np.array([0.0, 0.0, LIFT_HEIGHT])), speed=DESCEND_SPEED
         )
 
     def _verify(self) -> None:
@@ -297,7 +297,7 @@ class Grasp(_ManipulationSkill):
 
 
 class PutParams(StrictModel):
-    on: str = Field(description="the support surface to put the held object on")
+    surface: str = Field(description="the support surface to put the held object on")
     at: tuple[float, float] | None = Field(None, description="[x, y] spot (m, world); default: straight ahead")
     side: Side = Field("right", description="the hand holding the object")
 
@@ -308,7 +308,7 @@ class Put(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: PutParams, context: CheckContext) -> list[tuple[str, str]]:
-        return _check_surface(params.on, context, "on")
+        return _check_surface(params.surface, context, "surface")
 
     def phases(self):
         return [
@@ -325,7 +325,7 @@ class Put(_ManipulationSkill):
         self.held = self.context.world_model.held(side)
         if self.held is None:
             raise PhaseFailure(f"the {side} hand holds nothing")
-        self.surface = self._surface(self.params.on)
+        self.surface = self._surface(self.params.surface)
         whole_body = self.context.robot.whole_body
         hand = whole_body.frame_pose(whole_body.hand_frame(side))
         if self.params.at is not None:
@@ -347,7 +347,7 @@ class Put(_ManipulationSkill):
 
     def _above(self) -> MotionHandle:
         limits = [self._keepout(self.surface), self._clearance(self.params.side, self.surface, self.below_hand)]
-        target = pin.SE3(self.rotation, self.release + [0, 0, APPROACH_CLEARANCE + 0.02])
+        target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, APPROACH_CLEARANCE + 0.02]))
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
 
     def _lower(self) -> MotionHandle:
@@ -370,7 +370,7 @@ class Put(_ManipulationSkill):
         return self.context.robot.grippers.command(self.params.side, "open")
 
     def _retreat(self) -> MotionHandle:
-        target = pin.SE3(self.rotation, self.release + [0, 0, LIFT_HEIGHT])
+        target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, LIFT_HEIGHT]))
         return self.context.robot.whole_body.reach(
             self.params.side, target, speed=DESCEND_SPEED, move_base=False, tolerance=CARRY_TOLERANCE
         )

@@ -18,7 +18,6 @@ import pinocchio as pin
 from bt_humanoid.sim.assembly import robot_spec, write_robot_mjcf
 from bt_humanoid.sim.robot_config import RobotConfig
 
-
 _models: dict[Path, pin.Model] = {}
 
 

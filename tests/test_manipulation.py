@@ -1,0 +1,114 @@
+"""Pick and place end to end, judged in ground truth: missions, holding while driving, a moved target."""
+
+import numpy as np
+import pytest
+
+from bt_humanoid.paths import project_root
+from bt_humanoid.testing.scenario import Scenario, build_run
+
+MISSIONS = project_root() / "missions"
+
+TO_THE_TABLE = [
+    {"move_base": {"x": 0.6, "y": -0.9, "yaw": 0}},
+    {"move_base": {"x": 2.0, "y": -0.9, "yaw": 90}},
+]
+
+
+def test_red_cube_goes_from_the_table_to_the_counter(run_mission):
+    scenario = run_mission(MISSIONS / "pick_and_place.yaml")
+    assert scenario.result.success, scenario.result.summary()
+    x, y, _ = scenario.truth.object_position("red cube")
+    assert np.hypot(x - 8.4, y - 2.8) < 0.03
+    assert scenario.truth.rests_on("red cube", "counter")
+    assert scenario.final_speed() < 0.01
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the bottle's grasp from the table's west edge drives the arm into its joint limits (issue 3 note)",
+)
+def test_water_bottle_goes_upright_from_the_table_to_the_counter(run_mission):
+    scenario = run_mission(MISSIONS / "pick_and_place_bottle.yaml")
+    assert scenario.result.success, scenario.result.summary()
+    assert scenario.truth.upright("water bottle")
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the descent onto the mug from the counter's edge stops short of the grasp height (issue 3 note)",
+)
+def test_coffee_mug_goes_upright_from_the_counter_to_the_table(run_mission):
+    scenario = run_mission(MISSIONS / "pick_and_place_mug.yaml")
+    assert scenario.result.success, scenario.result.summary()
+    assert scenario.truth.upright("coffee mug")
+
+
+def _offset_in_hand(scenario_run, obj: str) -> np.ndarray:
+    """Object position in the grip-site frame (ground truth): what slipping changes."""
+    data, model = scenario_run.sim.data, scenario_run.sim.model
+    site = model.site("r_grip").id
+    rotation = data.site_xmat[site].reshape(3, 3)
+    return rotation.T @ (scenario_run.truth.object_position(obj) - data.site_xpos[site])
+
+
+def test_held_cube_does_not_slip_while_the_base_drives_and_turns():
+    mission = {
+        "mission": "hold while driving",
+        "tree": {
+            "sequence": [
+                *TO_THE_TABLE,
+                {"pick": {"object": "red cube"}},
+                {"move_base": {"x": 2.0, "y": -0.9, "yaw": 0}},
+                {
+                    "name": "drive",
+                    "sequence": [
+                        {"move_base": {"relative": True, "x": 2.0}},
+                        {"move_base": {"relative": True, "yaw": 180}},
+                    ],
+                },
+            ]
+        },
+    }
+    run = build_run(mission)
+    samples: list[tuple[float, np.ndarray]] = []
+    run.executor.observers.append(lambda: samples.append((run.sim.time, _offset_in_hand(run, "red cube"))))
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    assert scenario.truth.in_hand("red cube") == "right"
+    started = next(
+        e["t"] for e in scenario.events if e.get("node") == "sequence[4].sequence" and e.get("new") == "RUNNING"
+    )
+    before = next(offset for t, offset in samples if t >= started)
+    after = samples[-1][1]
+    slip = float(np.linalg.norm(after - before))
+    assert slip < 0.005, f"slipped {slip * 1000:.1f} mm"
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the second re-grasp drives the right wrist yaw past its limit margin; the safety stop brakes, "
+    "but the arm is still settling when the run ends (issue 3 note)",
+)
+def test_target_moved_during_the_approach_ends_in_a_clear_failure_at_rest():
+    mission = {
+        "mission": "pick a cube that moves",
+        "tree": {"sequence": [*TO_THE_TABLE, {"pick": {"object": "red cube"}}]},
+    }
+    run = build_run(mission)
+    cube = run.sim.model.joint("red_cube").qposadr[0]
+    moved = []
+
+    def push_the_cube_away() -> None:
+        # the fault: once the pick has started, the cube is somewhere else (a person took it)
+        if not moved and run.sim.time > 6.5:
+            run.sim.data.qpos[cube + 1] -= 0.3
+            moved.append(run.sim.time)
+
+    run.executor.observers.append(push_the_cube_away)
+    scenario = Scenario(run, run.execute())
+    assert moved, "the fault was never injected"
+    assert scenario.result.tree_status == "FAILURE"
+    failures = [e for e in scenario.events if e["event"] == "status" and e["new"] == "FAILURE" and "grasp" in e["node"]]
+    assert failures and any("not holding" in e["feedback"] or "nothing" in e["feedback"] for e in failures)
+    assert scenario.final_speed() < 0.01  # never left stuck RUNNING or moving
+    assert scenario.truth.in_hand("red cube") is None
