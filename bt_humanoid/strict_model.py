@@ -7,3 +7,9 @@ from pydantic import BaseModel, ConfigDict
 
 class StrictModel(BaseModel):
     model_config = ConfigDict(extra="forbid")
+
+
+def exactly_one(model: BaseModel, *fields: str) -> None:
+    """For ``model_validator``s: exactly one of ``fields`` must be given (not None)."""
+    if sum(getattr(model, name) is not None for name in fields) != 1:
+        raise ValueError(f"give exactly one of {' or '.join(fields)}")

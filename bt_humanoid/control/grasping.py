@@ -23,7 +23,7 @@ SURFACE_CLEARANCE = 0.006  # m: pads stay this far above the support surface
 TOP_CLEARANCE = 0.008  # m: palm stays this far above the object's top
 PRE_GRASP_HEIGHT = 0.1  # m above the grasp: the hand comes down from here
 LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
-MAX_OPENING = 0.1  # m between the pads when the gripper is fully open
+OPENING_MARGIN = 0.01  # m the open pads must clear the object by, in total
 
 # hand yaw relative to the base heading that suits each arm best for top-down grasps: the pads face left
 # and right (as a person's thumb and fingers do), which keeps the wrist far from its pitch limits
@@ -56,19 +56,22 @@ def natural_hand_yaw(side: str, base_yaw: float) -> float:
     return float(wrap_angle(base_yaw + NATURAL_YAW[side]))
 
 
-def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float) -> Grasp:
-    """A top-down grasp of ``obj`` standing on a surface at ``support_height``, hand yaw nearest ``hand_yaw``."""
+def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_opening: float) -> Grasp:
+    """A top-down grasp of ``obj`` standing on a surface at ``support_height``, hand yaw nearest ``hand_yaw``.
+
+    ``max_opening`` is the gap between the pads of the open gripper (m).
+    """
     if obj.kind not in SYMMETRY:
         raise GraspError(f"no grasp for objects of kind {obj.kind!r}; graspable kinds: {', '.join(SYMMETRY)}")
     # mugs: close across the body, at right angles to the handle (which points along the mug's x)
     base_yaw = obj.yaw + (math.pi / 2 if obj.kind == "mug" else 0.0)
     period = SYMMETRY[obj.kind]
     yaw = hand_yaw if period == 0.0 else base_yaw + period * round(wrap_angle(hand_yaw - base_yaw) / period)
-    # width across the closing direction: the box's side facing the pads, or the diameter
-    across = obj.size[0] if obj.kind in ("cube", "box") and round((yaw - obj.yaw) / (math.pi / 2)) % 2 == 0 else None
-    width = float(across if across is not None else (obj.size[1] if obj.kind in ("cube", "box") else obj.size[0]))
-    if width > MAX_OPENING - 0.01:
-        raise GraspError(f"{obj.name} is {width * 100:.0f} cm wide; the gripper opens {MAX_OPENING * 100:.0f} cm")
+    # the object's extent along the closing direction (the hand's x axis)
+    turn = yaw - obj.yaw
+    width = float(abs(math.cos(turn)) * obj.size[0] + abs(math.sin(turn)) * obj.size[1])
+    if width > max_opening - OPENING_MARGIN:
+        raise GraspError(f"{obj.name} is {width * 100:.0f} cm wide; the gripper opens {max_opening * 100:.0f} cm")
     # as high as the palm allows (keeps tall things steady), never so low that the pads touch the surface
     height = max(obj.top - PALM_ABOVE_GRIP - TOP_CLEARANCE, support_height + PAD_HALF_HEIGHT + SURFACE_CLEARANCE)
     height = min(height, obj.top - 0.01)

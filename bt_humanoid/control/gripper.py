@@ -37,10 +37,10 @@ class GripperController:
     def step(self) -> None:
         """Judge grasps in progress: stalled on something, or shut on nothing."""
         for side, (handle, started) in list(self._grasps.items()):
-            idx = self.joints.indices(self.grippers[side].joints)
             if handle.done:
                 del self._grasps[side]
                 continue
+            idx = self.joints.indices(self.grippers[side].joints)
             elapsed = self.joints.io.time - started
             stalled = np.all(np.abs(self.joints.io.velocities()[idx]) < STALL_SPEED)
             if elapsed < MIN_CLOSING_TIME or not (stalled or elapsed > GRASP_TIMEOUT):

@@ -12,16 +12,18 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from ruckig import Trajectory
 
 from bt_humanoid.control.base_driver import BaseDriver
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.motion import MotionHandle, plan_trajectory
 from bt_humanoid.control.wbc import RobotKinematics, solve_ik
 from bt_humanoid.control.wbc.limits import JointPositionLimit, Limit, TorsoMarginLimit, VelocityLimit
+from bt_humanoid.control.wbc.solver import BoxLimit
 from bt_humanoid.control.wbc.tasks import DampingTask, FrameTask, GazeTask, PostureTask, Task
 from bt_humanoid.sim.robot_config import RobotConfig
 
@@ -31,6 +33,7 @@ HAND_JERK = 6.0  # m/s^3
 HAND_TURN_RATE = 1.2  # rad/s of hand orientation change
 POSITION_TOLERANCE = 0.012  # m: measured hand within this of the target counts as arrived
 ORIENTATION_TOLERANCE = 0.12  # rad
+GAZE_TOLERANCE = 0.03  # rad between the optical axis and the direction to a look_at point
 SETTLE_TIMEOUT = 1.5  # s after the trajectory ends before an unfinished reach fails
 HAND_TORSO_MARGIN = 0.2  # m from the torso's vertical axis that the hands keep out of
 ELBOW_TORSO_MARGIN = 0.25  # m for the elbows: keeps the upper arms off the chest
@@ -47,18 +50,19 @@ class WholeBodyGoal:
 
     handle: MotionHandle
     tasks: list[Task]
+    box_limits: list[BoxLimit]
     limits: list[Limit]
-    frozen: list[int]  # controlled-joint indices that must not move
     start: float
     duration: float
-    path: object = None  # ruckig.Trajectory over the path parameter s ∈ [0, 1]
+    path: Trajectory | None = None  # over the path parameter s ∈ [0, 1]
     frame_task: FrameTask | None = None
     start_pose: pin.SE3 | None = None
     target_pose: pin.SE3 | None = None
     gaze_task: GazeTask | None = None
-    failures: int = 0
     tolerance: tuple[float, float] = (POSITION_TOLERANCE, ORIENTATION_TOLERANCE)
-    extra: dict = field(default_factory=dict)
+    stop_on_contact: bool = False
+    failures: int = 0  # consecutive unsolved QPs
+    position_error: float | None = None  # measured, once the path has ended
 
 
 class WholeBodyController:
@@ -87,7 +91,8 @@ class WholeBodyController:
             [limits.max_speed, limits.max_speed, limits.max_yaw_rate]
             + [config.motion_limits(j).velocity for j in body_joints]
         )
-        self.box_limits = [JointPositionLimit(lower, upper), VelocityLimit(max_velocity)]
+        self.position_limit = JointPositionLimit(lower, upper)
+        self.max_velocity = max_velocity
         margins = {g.grip_site: HAND_TORSO_MARGIN for g in config.grippers.values()}
         margins.update(
             {config.frames[f][1]: ELBOW_TORSO_MARGIN for f in ("left_elbow", "right_elbow") if f in config.frames}
@@ -163,13 +168,13 @@ class WholeBodyController:
         else:
             tasks.append(PostureTask({j: self.reference[self.names.index(j)] for j in self._head_joints()}, 1.0))
         tasks.append(DampingTask(self.base_joints, BASE_WEIGHT))
-        frozen = [] if move_base else [0, 1, 2]
+        frozen = [] if move_base else self.base_joints
         handle = MotionHandle(f"reaching {distance * 100:.0f} cm with the {side} hand", on_cancel=self._cancelled)
         self.goal = WholeBodyGoal(
             handle,
             tasks,
+            self._box_limits(frozen),
             [self.torso_limit, *(limits or [])],
-            frozen,
             self.joints.io.time,
             path.duration,
             path=path,
@@ -178,7 +183,7 @@ class WholeBodyController:
             target_pose=target,
             gaze_task=gaze_task,
             tolerance=tolerance,
-            extra={"stop_on_contact": stop_on_contact},
+            stop_on_contact=stop_on_contact,
         )
         return handle
 
@@ -189,10 +194,11 @@ class WholeBodyController:
         gaze = GazeTask(camera, np.asarray(point, dtype=float), weight=1.0, gain=0.3)
         head = set(self._head_joints())
         hold = {j: self.reference[i] for i, j in enumerate(self.names) if j not in head}
-        frozen = [i for i, j in enumerate(self.names) if j not in head]
         handle = MotionHandle("turning the head", on_cancel=self._cancelled)
-        self.goal = WholeBodyGoal(handle, [gaze, PostureTask(hold, 1.0)], [], frozen, self.joints.io.time, 0.0)
-        self.goal.gaze_task = gaze
+        tasks = [gaze, PostureTask(hold, 1.0)]
+        self.goal = WholeBodyGoal(
+            handle, tasks, self._box_limits(list(hold)), [], self.joints.io.time, 0.0, gaze_task=gaze
+        )
         return handle
 
     def cancel(self) -> None:
@@ -208,14 +214,14 @@ class WholeBodyController:
         if goal is None:
             return
         elapsed = self.joints.io.time - goal.start
-        if goal.frame_task is not None and goal.path is not None:
+        if goal.path is not None:
             s = float(goal.path.at_time(min(elapsed, goal.duration))[0][0])
             goal.frame_task.target = pin.SE3.Interpolate(goal.start_pose, goal.target_pose, s)
         # the base is velocity-controlled and gets pushed by the arms' reactions: solve at its measured pose
         # (odometry) so the hand lands where it should in the world; the base itself tracks base_target
         self.reference[:3] = self.base.pose()
         self.kinematics.update(self.reference)
-        solution = solve_ik(self.kinematics, goal.tasks, self._box_limits(goal), goal.limits, self.dt)
+        solution = solve_ik(self.kinematics, goal.tasks, goal.box_limits, goal.limits, self.dt)
         self.solve_times.append(solution.solve_time)
         goal.failures = 0 if solution.solved else goal.failures + 1
         if goal.failures >= FAILED_SOLVES:
@@ -237,13 +243,13 @@ class WholeBodyController:
         self.reference = np.concatenate([self.base.pose(), self.joints.position[self._body_index]])
         self.base_target = self.reference[:3].copy()
 
-    def _box_limits(self, goal: WholeBodyGoal) -> list:
-        if not goal.frozen:
-            return self.box_limits
-        return [*self.box_limits, _Frozen(goal.frozen, len(self.names))]
+    def _box_limits(self, frozen: list[str]) -> list[BoxLimit]:
+        """Position and velocity bounds for one goal; ``frozen`` joints get a zero speed limit."""
+        speed = np.array([0.0 if name in frozen else v for name, v in zip(self.names, self.max_velocity, strict=True)])
+        return [self.position_limit, VelocityLimit(speed)]
 
     def _check_done(self, goal: WholeBodyGoal, elapsed: float) -> None:
-        if goal.extra.get("stop_on_contact") and goal.frame_task is not None:
+        if goal.stop_on_contact and goal.frame_task is not None:
             self.measured.update(self.measured_positions())
             frame = goal.frame_task.frame
             lag = self.kinematics.pose(frame).translation - self.measured.pose(frame).translation
@@ -256,20 +262,18 @@ class WholeBodyController:
             goal.handle.feedback = f"{goal.handle.description}: {elapsed:.1f}/{goal.duration:.1f} s"
             return
         self.measured.update(self.measured_positions())
-        errors = []
         if goal.frame_task is not None:
             error = goal.frame_task.error(self.measured)
-            errors += [float(np.linalg.norm(error[:3])) <= goal.tolerance[0]]
-            errors += [float(np.linalg.norm(error[3:])) <= goal.tolerance[1]]
-            goal.extra["position_error"] = float(np.linalg.norm(error[:3]))
-        if goal.gaze_task is not None and goal.frame_task is None:
-            errors.append(float(np.linalg.norm(goal.gaze_task.error(self.measured))) < 0.03)
-        if all(errors):
-            miss = goal.extra.get("position_error")
+            goal.position_error = float(np.linalg.norm(error[:3]))
+            arrived = goal.position_error <= goal.tolerance[0] and np.linalg.norm(error[3:]) <= goal.tolerance[1]
+        else:  # look_at: only the gaze
+            arrived = float(np.linalg.norm(goal.gaze_task.error(self.measured))) < GAZE_TOLERANCE
+        miss = goal.position_error
+        if arrived:
             self._finish(goal, True, "arrived" if miss is None else f"arrived within {miss * 100:.1f} cm")
         elif elapsed > goal.duration + SETTLE_TIMEOUT:
-            miss = goal.extra.get("position_error", 0.0)
-            self._finish(goal, False, f"hand stopped {miss * 100:.1f} cm from its target: blocked or out of reach")
+            where = "" if miss is None else f"hand stopped {miss * 100:.1f} cm from its target: "
+            self._finish(goal, False, f"{where}blocked or out of reach")
 
     def _finish(self, goal: WholeBodyGoal, success: bool, message: str) -> None:
         self.goal = None
@@ -291,18 +295,6 @@ class WholeBodyController:
 
     def _head_joints(self) -> list[str]:
         return list(self.config.groups.get("head", []))
-
-
-class _Frozen:
-    """Box limit that pins some joints: Δq = 0 for ``indices``."""
-
-    def __init__(self, indices: list[int], n: int) -> None:
-        self.mask = np.zeros(n, dtype=bool)
-        self.mask[indices] = True
-
-    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        bound = np.where(self.mask, 0.0, np.inf)
-        return -bound, bound
 
 
 def yaw_rotation(yaw: float) -> np.ndarray:

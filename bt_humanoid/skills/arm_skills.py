@@ -10,12 +10,12 @@ from pydantic import Field, model_validator
 
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.whole_body import yaw_rotation
-from bt_humanoid.errors import did_you_mean
 from bt_humanoid.skills.context import CheckContext
-from bt_humanoid.skills.manipulation_skills import Side, _check_object, _ManipulationSkill
+from bt_humanoid.skills.manipulation_skills import Side, _ManipulationSkill
+from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
-from bt_humanoid.strict_model import StrictModel
+from bt_humanoid.strict_model import StrictModel, exactly_one
 
 GIVE_REACH = 0.5  # m ahead of the base, towards the person, where the hand holds the object out
 GIVE_HEIGHT = 1.0  # m
@@ -27,8 +27,7 @@ class LookAtParams(StrictModel):
 
     @model_validator(mode="after")
     def _one_target(self) -> LookAtParams:
-        if (self.object is None) == (self.point is None):
-            raise ValueError("give exactly one of object or point")
+        exactly_one(self, "object", "point")
         return self
 
 
@@ -38,7 +37,7 @@ class LookAt(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: LookAtParams, context: CheckContext) -> list[tuple[str, str]]:
-        return _check_object(params.object, context) if params.object is not None else []
+        return check_name(params.object, context.world.objects, "object", "object")
 
     def phases(self):
         return [("look", self._look)]
@@ -89,9 +88,7 @@ class Give(_ManipulationSkill):
     @classmethod
     def check(cls, params: GiveParams, context: CheckContext) -> list[tuple[str, str]]:
         names = [n for name, person in context.world.people.items() for n in (name, *person.aliases)]
-        if params.to in names:
-            return []
-        return [("to", f"unknown person '{params.to}' ({did_you_mean(params.to, names)})")]
+        return check_name(params.to, names, "to", "person")
 
     def phases(self):
         return [("hold out", self._hold_out), ("wait", self._wait), ("let go", self._let_go)]
@@ -111,26 +108,19 @@ class Give(_ManipulationSkill):
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=person, move_base=False)
 
     def _wait(self) -> MotionHandle:
-        handle = MotionHandle("holding it out")
-        started = self.context.clock()
-        blackboard = self.context.blackboard
-
-        def poll() -> None:
-            if blackboard.values.get(self.params.release_key):
-                handle.succeed("asked to let go")
-            elif self.context.clock() - started > self.params.timeout:
-                handle.succeed(f"let go after {self.params.timeout:.0f} s")
-            else:
-                handle.feedback = f"holding it out for {self.context.clock() - started:.0f} s"
-
-        handle.poll = poll  # type: ignore[attr-defined]
-        self._waiting = handle
-        return handle
+        # no controller drives this wait: poll() settles the handle from the blackboard and the clock
+        self.wait_started = self.context.clock()
+        return MotionHandle("holding it out")
 
     def poll(self):
-        waiting = getattr(self, "_waiting", None)
-        if waiting is not None and waiting is self.motion:
-            waiting.poll()
+        if self.phase == "wait" and self.motion is not None and not self.motion.done:
+            waited = self.context.clock() - self.wait_started
+            if self.context.blackboard.values.get(self.params.release_key):
+                self.motion.succeed("asked to let go")
+            elif waited > self.params.timeout:
+                self.motion.succeed(f"let go after {self.params.timeout:.0f} s")
+            else:
+                self.motion.feedback = f"holding it out for {waited:.0f} s"
         return super().poll()
 
     def _let_go(self) -> MotionHandle:

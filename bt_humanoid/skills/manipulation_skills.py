@@ -12,20 +12,19 @@ from typing import Literal
 
 import numpy as np
 import pinocchio as pin
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from bt_humanoid.control.grasping import LIFT_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
-from bt_humanoid.errors import did_you_mean
 from bt_humanoid.perception.world_model import SupportSurface, TrackedObject
 from bt_humanoid.skills.context import CheckContext
-from bt_humanoid.skills.params import is_reference
+from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
-from bt_humanoid.strict_model import StrictModel
+from bt_humanoid.strict_model import StrictModel, exactly_one
 
 Side = Literal["left", "right"]
 APPROACH_CLEARANCE = 0.06  # m the hand (or what it holds) keeps above a surface while moving over it
@@ -40,18 +39,6 @@ CARRY_HEIGHT = 0.95  # m above the floor, at least
 CARRY_CLEARANCE = 0.04  # m above the highest known surface for the bottom of what is carried
 MAX_CARRY_HEIGHT = 1.15  # m: the arm's comfortable limit
 CARRY_TOLERANCE = (0.03, 0.2)  # m, rad: the carry pose needs no precision
-
-
-def _check_object(name: str, context: CheckContext) -> list[tuple[str, str]]:
-    if is_reference(name) or name in context.world.objects:
-        return []
-    return [("object", f"unknown object '{name}' ({did_you_mean(name, context.world.objects)})")]
-
-
-def _check_surface(name: str, context: CheckContext, parameter: str) -> list[tuple[str, str]]:
-    if is_reference(name) or name in context.world.surfaces:
-        return []
-    return [(parameter, f"unknown surface '{name}' ({did_you_mean(name, context.world.surfaces)})")]
 
 
 class _ManipulationSkill(PhasedSkill):
@@ -76,9 +63,6 @@ class _ManipulationSkill(PhasedSkill):
     def _hand_yaw(self, side: str) -> float:
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
         return math.atan2(rotation[1, 0], rotation[0, 0])
-
-    def _natural_yaw(self, side: str) -> float:
-        return natural_hand_yaw(side, float(self.context.robot.base.pose()[2]))
 
     def _carry(self, side: str, surfaces: list[SupportSurface]) -> MotionHandle:
         """Bring the hand in front of the body, high enough to carry what it holds past furniture."""
@@ -119,6 +103,11 @@ class StandNearParams(StrictModel):
     side: Side = Field("right", description="the hand that will work")
     max_speed: float = Field(0.3, gt=0, le=0.8, description="m/s cap for this short, final approach")
 
+    @model_validator(mode="after")
+    def _one_target(self) -> StandNearParams:
+        exactly_one(self, "object", "surface")
+        return self
+
 
 @skill("stand_near", "drive (straight, short) to a stance from which one hand reaches an object or a surface spot")
 class StandNear(_ManipulationSkill):
@@ -126,11 +115,10 @@ class StandNear(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: StandNearParams, context: CheckContext) -> list[tuple[str, str]]:
-        if (params.object is None) == (params.surface is None):
-            return [("object", "give exactly one of object or surface")]
-        if params.object is not None:
-            return _check_object(params.object, context)
-        return _check_surface(params.surface, context, "surface")
+        world = context.world
+        return check_name(params.object, world.objects, "object", "object") + check_name(
+            params.surface, world.surfaces, "surface", "surface"
+        )
 
     def phases(self):
         return [
@@ -198,7 +186,7 @@ class Grasp(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: GraspParams, context: CheckContext) -> list[tuple[str, str]]:
-        return _check_object(params.object, context)
+        return check_name(params.object, context.world.objects, "object", "object")
 
     def phases(self):
         return [
@@ -224,7 +212,9 @@ class Grasp(_ManipulationSkill):
             raise PhaseFailure(f"{self.target.name} is not on a known surface")
         self.surface = surface
         try:
-            self.grasp = plan_grasp(self.target, surface.height, self._hand_yaw(side))
+            gripper = self.context.robot_config.grippers[side]
+            opening = len(gripper.joints) * gripper.open  # pads touch at 0: each finger adds its travel
+            self.grasp = plan_grasp(self.target, surface.height, self._hand_yaw(side), opening)
         except GraspError as error:
             raise PhaseFailure(str(error)) from None
 
@@ -275,9 +265,7 @@ class Grasp(_ManipulationSkill):
         self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
 
     def _lift(self) -> MotionHandle:
-        return self.context.robot.whole_body.reach(
-            self.params.side, self._pose(self.grasp.position + np.array([0.0, 0.0, LIFT_HEIGHT])), speed=DESCEND_SPEED
-        )
+        return self.context.robot.whole_body.reach(self.params.side, self._pose(self.grasp.lifted), speed=DESCEND_SPEED)
 
     def _verify(self) -> None:
         grippers = self.context.robot.grippers
@@ -308,7 +296,7 @@ class Put(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: PutParams, context: CheckContext) -> list[tuple[str, str]]:
-        return _check_surface(params.surface, context, "surface")
+        return check_name(params.surface, context.world.surfaces, "surface", "surface")
 
     def phases(self):
         return [
@@ -364,8 +352,8 @@ class Put(_ManipulationSkill):
     def _release(self) -> MotionHandle:
         hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
         self.held.held_by = None
-        self.held.position = np.array([hand.translation[0], hand.translation[1], self.surface.height])
-        self.held.position[2] += self.held.size[2] / 2
+        x, y, _ = hand.translation
+        self.held.position = np.array([x, y, self.surface.height + self.held.size[2] / 2])
         self.held.last_seen = self.context.clock()
         return self.context.robot.grippers.command(self.params.side, "open")
 

@@ -8,11 +8,11 @@ from typing import Literal
 from pydantic import Field, model_validator
 
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.errors import did_you_mean
 from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.registry import skill
-from bt_humanoid.strict_model import StrictModel
+from bt_humanoid.strict_model import StrictModel, exactly_one
 
 
 class MoveBaseParams(StrictModel):
@@ -42,9 +42,7 @@ class MoveBase(Skill):
 
     @classmethod
     def check(cls, params: MoveBaseParams, context: CheckContext) -> list[tuple[str, str]]:
-        if params.place is not None and params.place not in context.world.places:
-            return [("place", f"unknown place '{params.place}' ({did_you_mean(params.place, context.world.places)})")]
-        return []
+        return check_name(params.place, context.world.places, "place", "place")
 
     def start(self) -> MotionHandle:
         p: MoveBaseParams = self.params
@@ -71,8 +69,7 @@ class MoveJointsParams(StrictModel):
 
     @model_validator(mode="after")
     def _one_target(self) -> MoveJointsParams:
-        if (self.posture is None) == (self.joints is None):
-            raise ValueError("give exactly one of posture or joints")
+        exactly_one(self, "posture", "joints")
         return self
 
 
@@ -83,14 +80,11 @@ class MoveJoints(Skill):
     @classmethod
     def check(cls, params: MoveJointsParams, context: CheckContext) -> list[tuple[str, str]]:
         config = context.robot_config
-        if params.posture is not None and params.posture not in config.postures:
-            return [
-                ("posture", f"unknown posture '{params.posture}' ({did_you_mean(params.posture, config.postures)})")
-            ]
-        problems = []
+        problems = check_name(params.posture, config.postures, "posture", "posture")
         for joint, value in (params.joints or {}).items():
-            if joint not in config.actuated_joints:
-                problems.append(("joints", f"unknown joint '{joint}' ({did_you_mean(joint, config.actuated_joints)})"))
+            unknown = check_name(joint, config.actuated_joints, "joints", "joint")
+            if unknown:
+                problems += unknown
                 continue
             low, high = context.joint_ranges[joint]
             if not low <= value <= high:

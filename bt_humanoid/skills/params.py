@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Any
+
+from bt_humanoid.errors import did_you_mean
 
 
 def is_reference(value: Any) -> bool:
@@ -20,3 +23,14 @@ def resolve_references(value: Any, blackboard: Any) -> Any:
     if isinstance(value, list):
         return [resolve_references(v, blackboard) for v in value]
     return value
+
+
+def check_name(value: str | None, valid: Iterable[str], parameter: str, what: str) -> list[tuple[str, str]]:
+    """Compile-time check that ``value`` (if given) names one of ``valid``, as (parameter, message) pairs.
+
+    Leaves with blackboard references are not checked at all (the loader skips them).
+    """
+    valid = list(valid)
+    if value is None or value in valid:
+        return []
+    return [(parameter, f"unknown {what} '{value}' ({did_you_mean(value, valid)})")]

@@ -72,6 +72,7 @@ class RobotKinematics:
         self._q_index = np.array(q_index)
         self._v_index = np.array(v_index)
         self._frame_ids: dict[str, int] = {}
+        self._jacobians: dict[str, np.ndarray] = {}  # per update(): tasks and limits ask for the same frames
 
     def index(self, joint: str) -> int:
         return self.joints.index(joint)
@@ -82,6 +83,7 @@ class RobotKinematics:
         self.q[self._q_index] = self.positions
         pin.computeJointJacobians(self.model, self.data, self.q)
         pin.updateFramePlacements(self.model, self.data)
+        self._jacobians.clear()
 
     def frame_id(self, frame: str) -> int:
         if frame not in self._frame_ids:
@@ -96,5 +98,7 @@ class RobotKinematics:
 
     def jacobian(self, frame: str) -> np.ndarray:
         """6 × n Jacobian (linear; angular) of the frame origin in world-aligned axes."""
-        full = pin.getFrameJacobian(self.model, self.data, self.frame_id(frame), pin.LOCAL_WORLD_ALIGNED)
-        return full[:, self._v_index]
+        if frame not in self._jacobians:
+            full = pin.getFrameJacobian(self.model, self.data, self.frame_id(frame), pin.LOCAL_WORLD_ALIGNED)
+            self._jacobians[frame] = full[:, self._v_index]
+        return self._jacobians[frame]

@@ -14,9 +14,13 @@ class DampingTask(Task):
     def __init__(self, joints: list[str], weight: float = 1.0) -> None:
         super().__init__(weight, gain=1.0)
         self.joints = joints
+        self._zero = np.zeros(len(joints))
+        self._selection: np.ndarray | None = None  # constant: built on first use
 
     def error(self, kinematics: RobotKinematics) -> np.ndarray:
-        return np.zeros(len(self.joints))
+        return self._zero
 
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
-        return np.eye(len(kinematics.joints))[[kinematics.index(j) for j in self.joints]]
+        if self._selection is None:
+            self._selection = np.eye(len(kinematics.joints))[[kinematics.index(j) for j in self.joints]]
+        return self._selection

@@ -14,13 +14,17 @@ class PostureTask(Task):
     def __init__(self, posture: dict[str, float], weight: float = 1e-2, gain: float = 0.1) -> None:
         super().__init__(weight, gain)
         self.posture = posture
+        self.target = np.array(list(posture.values()), dtype=float)
+        self._selection: np.ndarray | None = None  # constant: built on first use, the control loop reuses it
 
-    def _rows(self, kinematics: RobotKinematics) -> np.ndarray:
-        return np.array([kinematics.index(joint) for joint in self.posture], dtype=int)
+    def _select(self, kinematics: RobotKinematics) -> np.ndarray:
+        if self._selection is None:
+            rows = [kinematics.index(joint) for joint in self.posture]
+            self._selection = np.eye(len(kinematics.joints))[rows]
+        return self._selection
 
     def error(self, kinematics: RobotKinematics) -> np.ndarray:
-        current = kinematics.positions[self._rows(kinematics)]
-        return np.array(list(self.posture.values())) - current
+        return self.target - self._select(kinematics) @ kinematics.positions
 
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
-        return np.eye(len(kinematics.joints))[self._rows(kinematics)]
+        return self._select(kinematics)
