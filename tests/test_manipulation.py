@@ -1,7 +1,6 @@
 """Pick and place end to end, judged in ground truth: missions, holding while driving, a moved target."""
 
 import numpy as np
-import pytest
 
 from bt_humanoid.paths import project_root
 from bt_humanoid.testing.scenario import Scenario, build_run
@@ -23,20 +22,12 @@ def test_red_cube_goes_from_the_table_to_the_counter(run_mission):
     assert scenario.final_speed() < 0.01
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the bottle's grasp from the table's west edge drives the arm into its joint limits (issue 3 note)",
-)
 def test_water_bottle_goes_upright_from_the_table_to_the_counter(run_mission):
     scenario = run_mission(MISSIONS / "pick_and_place_bottle.yaml")
     assert scenario.result.success, scenario.result.summary()
     assert scenario.truth.upright("water bottle")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the descent onto the mug from the counter's edge stops short of the grasp height (issue 3 note)",
-)
 def test_coffee_mug_goes_upright_from_the_counter_to_the_table(run_mission):
     scenario = run_mission(MISSIONS / "pick_and_place_mug.yaml")
     assert scenario.result.success, scenario.result.summary()
@@ -84,11 +75,6 @@ def test_held_cube_does_not_slip_while_the_base_drives_and_turns():
     assert slip < 0.005, f"slipped {slip * 1000:.1f} mm"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the second re-grasp drives the right wrist yaw past its limit margin; the safety stop brakes, "
-    "but the arm is still settling when the run ends (issue 3 note)",
-)
 def test_target_moved_during_the_approach_ends_in_a_clear_failure_at_rest():
     mission = {
         "mission": "pick a cube that moves",

@@ -18,16 +18,17 @@ from bt_humanoid.control.base_driver import wrap_angle
 from bt_humanoid.perception.world_model import TrackedObject
 
 PAD_HALF_HEIGHT = 0.03  # m: finger pads reach this far below and above the grip site
-PALM_ABOVE_GRIP = 0.065  # m: the palm's underside sits this far above the grip site
+PALM_ABOVE_GRIP = 0.06  # m: the palm's underside sits this far above the grip site
 SURFACE_CLEARANCE = 0.006  # m: pads stay this far above the support surface
 TOP_CLEARANCE = 0.008  # m: palm stays this far above the object's top
 PRE_GRASP_HEIGHT = 0.1  # m above the grasp: the hand comes down from here
 LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
 OPENING_MARGIN = 0.01  # m the open pads must clear the object by, in total
 
-# hand yaw relative to the base heading that suits each arm best for top-down grasps: the pads face left
-# and right (as a person's thumb and fingers do), which keeps the wrist far from its pitch limits
-NATURAL_YAW = {"right": -math.pi / 2, "left": math.pi / 2}
+# hand yaw relative to the base heading that suits either arm best for top-down grasps: the fingers close
+# along the heading, the forearm points forward and the wrist pitches the hand down (see the "ready"
+# posture in robot.yaml), which leaves every wrist joint mid-range
+NATURAL_YAW = 0.0
 
 SYMMETRY = {"cube": math.pi / 2, "box": math.pi / 2, "mug": math.pi, "bottle": 0.0, "can": 0.0, "ball": 0.0}
 
@@ -51,9 +52,9 @@ class GraspError(ValueError):
     """The object cannot be grasped by this hand (too wide, unknown shape)."""
 
 
-def natural_hand_yaw(side: str, base_yaw: float) -> float:
-    """The hand yaw (world) that suits ``side``'s arm when the base faces ``base_yaw``."""
-    return float(wrap_angle(base_yaw + NATURAL_YAW[side]))
+def natural_hand_yaw(base_yaw: float) -> float:
+    """The hand yaw (world) that suits either arm when the base faces ``base_yaw``."""
+    return float(wrap_angle(base_yaw + NATURAL_YAW))
 
 
 def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_opening: float) -> Grasp:
@@ -73,7 +74,7 @@ def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_o
     if width > max_opening - OPENING_MARGIN:
         raise GraspError(f"{obj.name} is {width * 100:.0f} cm wide; the gripper opens {max_opening * 100:.0f} cm")
     # as high as the palm allows (keeps tall things steady), never so low that the pads touch the surface
-    height = max(obj.top - PALM_ABOVE_GRIP - TOP_CLEARANCE, support_height + PAD_HALF_HEIGHT + SURFACE_CLEARANCE)
+    height = max(obj.top + TOP_CLEARANCE - PALM_ABOVE_GRIP, support_height + PAD_HALF_HEIGHT + SURFACE_CLEARANCE)
     height = min(height, obj.top - 0.01)
     position = np.array([obj.position[0], obj.position[1], height])
     return Grasp(position, float(wrap_angle(yaw)), width)

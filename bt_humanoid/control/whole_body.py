@@ -39,6 +39,7 @@ HAND_TORSO_MARGIN = 0.2  # m from the torso's vertical axis that the hands keep 
 ELBOW_TORSO_MARGIN = 0.25  # m for the elbows: keeps the upper arms off the chest
 POSTURE_WEIGHT = 0.02  # pull of the working arm towards READY_POSTURE (redundancy resolution)
 READY_POSTURE = "ready"
+WAIST_WEIGHT = 0.3  # pull of the waist towards straight: it turns only when the arm alone falls short
 BASE_WEIGHT = 1.0  # cost of base motion relative to arm motion (higher: the arm does more)
 FAILED_SOLVES = 10  # consecutive QP failures before a goal gives up
 CONTACT_LAG = 0.008  # m the measured hand lags its reference when something stops it (stop_on_contact)
@@ -156,11 +157,13 @@ class WholeBodyController:
         other = [s for s in self.config.grippers if s != side]
         held = {j: self.reference[self.names.index(j)] for s in other for j in self._arm_joints(s)}
         tasks.append(PostureTask(held, weight=1.0, gain=0.5))
-        # redundancy: pull the working arm towards its "ready" posture and the waist straight
+        # redundancy: pull the working arm and the lift towards the "ready" posture, and keep the waist straight
+        # (a turned chest swings into the forearm of a hand held in front of it)
         ready = self.config.postures.get(READY_POSTURE, {})
-        waist_and_arm = {j: ready.get(j, self.reference[self.names.index(j)]) for j in self._arm_joints(side)}
-        waist_and_arm.update({j: 0.0 for j in self.config.groups.get("waist", [])})
-        tasks.append(PostureTask(waist_and_arm, weight=POSTURE_WEIGHT, gain=0.05))
+        arm = [*self.config.groups.get("lift", []), *self._arm_joints(side)]
+        preferred = {j: ready.get(j, self.reference[self.names.index(j)]) for j in arm}
+        tasks.append(PostureTask(preferred, weight=POSTURE_WEIGHT, gain=0.05))
+        tasks.append(PostureTask({j: 0.0 for j in self.config.groups.get("waist", [])}, WAIST_WEIGHT, gain=0.2))
         gaze_task = None
         if gaze is not None:
             gaze_task = GazeTask(self.config.frames["head_camera"][1], gaze)

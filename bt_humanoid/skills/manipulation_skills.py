@@ -14,7 +14,7 @@ import numpy as np
 import pinocchio as pin
 from pydantic import Field, model_validator
 
-from bt_humanoid.control.grasping import LIFT_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
+from bt_humanoid.control.grasping import LIFT_HEIGHT, PAD_HALF_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Limit
@@ -33,11 +33,10 @@ DESCEND_SPEED = 0.1  # m/s for the last few centimetres to a grasp or a placemen
 RELEASE_GAP = 0.005  # m between a placed object's bottom and the surface when the gripper opens
 GRASP_WIDTH_TOLERANCE = 0.015  # m: a closed width further than this from the object's size is "something else"
 TUCKED_POSTURE = "tucked"  # robot.yaml posture for the idle arm near furniture
-CARRY_FORWARD = 0.3  # m ahead of the base centre where a held object is carried: behind the bumper line
-CARRY_SIDE = 0.2  # m to the side of the working hand
+CARRY_FORWARD = 0.38  # m ahead of the base centre where a held object is carried: clear of the chest
+CARRY_SIDE = 0.25  # m to the side of the working hand: outside the shoulder
 CARRY_HEIGHT = 0.95  # m above the floor, at least
-CARRY_CLEARANCE = 0.04  # m above the highest known surface for the bottom of what is carried
-MAX_CARRY_HEIGHT = 1.15  # m: the arm's comfortable limit
+MAX_CARRY_HEIGHT = 1.2  # m: the arm's comfortable limit (torso lifted)
 CARRY_TOLERANCE = (0.03, 0.2)  # m, rad: the carry pose needs no precision
 
 
@@ -64,7 +63,7 @@ class _ManipulationSkill(PhasedSkill):
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
         return math.atan2(rotation[1, 0], rotation[0, 0])
 
-    def _carry(self, side: str, surfaces: list[SupportSurface]) -> MotionHandle:
+    def _carry(self, side: str, surfaces: list[SupportSurface], extra_limits: list[Limit] = ()) -> MotionHandle:
         """Bring the hand in front of the body, high enough to carry what it holds past furniture."""
         x, y, yaw = self.context.robot.base.pose()
         lateral = -CARRY_SIDE if side == "right" else CARRY_SIDE
@@ -75,15 +74,15 @@ class _ManipulationSkill(PhasedSkill):
         held = self.context.world_model.held(side)
         below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
         highest = max((s.height for s in self.context.world_model.surfaces.values()), default=0.0)
-        height = min(max(CARRY_HEIGHT, highest + below_hand + CARRY_CLEARANCE), MAX_CARRY_HEIGHT)
+        height = min(max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE), MAX_CARRY_HEIGHT)
         # an empty hand turns to its natural yaw; a full one keeps its yaw (as grasped) so nothing swings
-        hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(side, yaw)
+        hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(yaw)
         target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, height]))
         return self.context.robot.whole_body.reach(
             side,
             target,
             move_base=False,
-            limits=[self._clearance(side, s, 0.0) for s in surfaces],
+            limits=[*(self._clearance(side, s, 0.0) for s in surfaces), *extra_limits],
             tolerance=CARRY_TOLERANCE,
         )
 
@@ -132,7 +131,7 @@ class StandNear(_ManipulationSkill):
         if self.context.world_model.held(self.params.side) is not None:
             return None
         config = self.context.robot_config
-        joints = config.groups.get(f"{self.params.side}_arm", [])
+        joints = [*config.groups.get("lift", []), *config.groups.get(f"{self.params.side}_arm", [])]
         ready = config.postures.get(READY_POSTURE, {})
         return self.context.robot.joints.move({j: ready[j] for j in joints if j in ready})
 
@@ -214,7 +213,8 @@ class Grasp(_ManipulationSkill):
         try:
             gripper = self.context.robot_config.grippers[side]
             opening = len(gripper.joints) * gripper.open  # pads touch at 0: each finger adds its travel
-            self.grasp = plan_grasp(self.target, surface.height, self._hand_yaw(side), opening)
+            base_yaw = self.context.robot.base.pose()[2]
+            self.grasp = plan_grasp(self.target, surface.height, natural_hand_yaw(base_yaw), opening)
         except GraspError as error:
             raise PhaseFailure(str(error)) from None
 
@@ -305,7 +305,7 @@ class Put(_ManipulationSkill):
             ("lower", self._lower),
             ("release", self._release),
             ("retreat", self._retreat),
-            ("carry", lambda: self._carry(self.params.side, [self.surface])),
+            ("carry", self._carry_away),
         ]
 
     def _plan(self) -> None:
@@ -358,10 +358,18 @@ class Put(_ManipulationSkill):
         return self.context.robot.grippers.command(self.params.side, "open")
 
     def _retreat(self) -> MotionHandle:
-        target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, LIFT_HEIGHT]))
+        """Straight up until the open pads clear the top of what was just put down."""
+        top_above_grip = float(self.held.size[2]) - self.below_hand
+        rise = max(LIFT_HEIGHT, top_above_grip + PAD_HALF_HEIGHT + APPROACH_CLEARANCE / 2)
+        target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, rise]))
         return self.context.robot.whole_body.reach(
             self.params.side, target, speed=DESCEND_SPEED, move_base=False, tolerance=CARRY_TOLERANCE
         )
+
+    def _carry_away(self) -> MotionHandle:
+        """Back to the carry pose, the pads kept above the placed object while the hand is over the surface."""
+        clearance = self._clearance(self.params.side, self.surface, float(self.held.size[2]) + PAD_HALF_HEIGHT)
+        return self._carry(self.params.side, [], extra_limits=[clearance])
 
 
 # --------------------------------------------------------------------------- release, look_at, give

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit
+from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
 
 
 class BaseKeepoutLimit(Limit):
@@ -26,4 +26,4 @@ class BaseKeepoutLimit(Limit):
             return Inequality.none(len(kinematics.joints))
         normal = offset / distance
         row = normal @ kinematics.jacobian(self.base_frame)[:2]
-        return Inequality(row[None, :], np.array([self.gain * (self.radius - distance)]))
+        return Inequality(row[None, :], np.array([gap_bound(self.gain, self.radius - distance, dt)]))

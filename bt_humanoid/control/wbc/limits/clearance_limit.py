@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit
+from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
 
 
 class ClearanceLimit(Limit):
@@ -27,4 +27,4 @@ class ClearanceLimit(Limit):
         if not inside:
             return Inequality.none(len(kinematics.joints))
         row = kinematics.jacobian(self.frame)[2:3]
-        return Inequality(row, np.array([self.gain * (self.height - position[2])]))
+        return Inequality(row, np.array([gap_bound(self.gain, self.height - position[2], dt)]))

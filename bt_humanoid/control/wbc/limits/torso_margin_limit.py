@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit
+from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
 
 
 class TorsoMarginLimit(Limit):
@@ -32,7 +32,7 @@ class TorsoMarginLimit(Limit):
                 continue
             normal = offset / distance
             rows.append(normal @ (kinematics.jacobian(frame)[:3] - torso_jac))
-            lower.append(self.gain * (margin - distance))
+            lower.append(gap_bound(self.gain, margin - distance, dt))
         if not rows:
             return Inequality.none(len(kinematics.joints))
         return Inequality(np.array(rows), np.array(lower))
