@@ -12,7 +12,7 @@ from bt_humanoid.testing.scenario import build_run
 MISSIONS = sorted((project_root() / "missions").glob("*.yaml"))
 BEHAVIORS = sorted(BehaviorLibrary().behaviors)
 # a valid value for every required behaviour parameter used in this repo
-SAMPLE_ARGS = {"place": "table", "object": "red cube", "surface": "counter", "x": 8.4, "y": 2.8}
+SAMPLE_ARGS = {"place": "table", "object": "red cube", "surface": "counter", "to": "counter", "x": 8.4, "y": 2.8}
 
 
 def assert_fully_wrapped(root: Behaviour) -> int:

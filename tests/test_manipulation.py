@@ -98,3 +98,65 @@ def test_target_moved_during_the_approach_ends_in_a_clear_failure_at_rest():
     assert failures and any("not holding" in e["feedback"] or "nothing" in e["feedback"] for e in failures)
     assert scenario.final_speed() < 0.01  # never left stuck RUNNING or moving
     assert scenario.truth.in_hand("red cube") is None
+
+
+def test_fetch_carries_the_mug_from_the_counter_to_the_shelf():
+    mission = {
+        "mission": "fetch the mug to the shelf",
+        "tree": {"fetch": {"object": "coffee mug", "to": "shelf", "x": 1.2, "y": 4.2}},
+    }
+    run = build_run(mission, robot_start=(7.0, 2.4, 0.0))  # in the kitchen: the drive to the shelf is clear
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    x, y, _ = scenario.truth.object_position("coffee mug")
+    assert np.hypot(x - 1.2, y - 4.2) < 0.03
+    assert scenario.truth.rests_on("coffee mug", "shelf")
+    assert scenario.truth.upright("coffee mug")
+
+
+def test_find_fails_clearly_when_the_object_is_no_longer_where_it_was_believed():
+    run = build_run({"mission": "find a lost cube", "tree": {"find": {"object": "red cube"}}})
+    run.context.world_model.object("red cube").confidence = 0.0  # as after a slip: whereabouts unknown
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "FAILURE"
+    assert "recall: I do not know where the red cube is now" in scenario.feedback("find")
+
+
+def _give(release_after: float | None, timeout: float) -> tuple[Scenario, list[float]]:
+    give = {"give": {"to": "person", "timeout": timeout}}
+    if release_after is not None:
+        asked = {"sequence": [{"wait": {"seconds": release_after}}, {"set": {"key": "release", "value": True}}]}
+        give = {"parallel": {"policy": "all", "children": [give, asked]}}
+    mission = {
+        "mission": "hand the cube over",
+        "tree": {"sequence": [*TO_THE_TABLE, {"pick": {"object": "red cube"}}, {"name": "handover", **give}]},
+    }
+    run = build_run(mission)
+    person = run.context.world_model.person("person")
+    reach: list[float] = []  # distance from the hand to the person while the cube is still held
+
+    def watch() -> None:
+        if run.truth.in_hand("red cube"):
+            reach.append(float(np.linalg.norm(run.sim.data.site("r_grip").xpos[:2] - person[:2])))
+
+    run.executor.observers.append(watch)
+    return Scenario(run, run.execute()), reach
+
+
+def test_give_holds_the_object_out_to_the_person_and_lets_go_after_the_timeout():
+    scenario, reach = _give(release_after=None, timeout=1.0)
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    assert scenario.truth.in_hand("red cube") is None
+    base = scenario.truth.robot_pose()
+    person = scenario.run.context.world_model.person("person")
+    # held out towards the person: the hand got well ahead of the base on the way to them
+    assert min(reach) < np.hypot(base[0] - person[0], base[1] - person[1]) - 0.35
+
+
+def test_give_lets_go_as_soon_as_asked():
+    scenario, _ = _give(release_after=4.0, timeout=60.0)
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    started = next(e["t"] for e in scenario.events if e.get("node") == "sequence[3].parallel" and e["new"] == "RUNNING")
+    ended = next(e["t"] for e in scenario.events if e.get("node") == "sequence[3].parallel" and e["new"] == "SUCCESS")
+    assert ended - started < 30.0  # long before the 60 s timeout
+    assert scenario.truth.in_hand("red cube") is None

@@ -70,7 +70,10 @@ def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_o
     yaw = hand_yaw if period == 0.0 else base_yaw + period * round(wrap_angle(hand_yaw - base_yaw) / period)
     # the object's extent along the closing direction (the hand's x axis)
     turn = yaw - obj.yaw
-    width = float(abs(math.cos(turn)) * obj.size[0] + abs(math.sin(turn)) * obj.size[1])
+    if period == 0.0:  # round: the diameter whichever way the pads close
+        width = float(obj.size[0])
+    else:
+        width = float(abs(math.cos(turn)) * obj.size[0] + abs(math.sin(turn)) * obj.size[1])
     if width > max_opening - OPENING_MARGIN:
         raise GraspError(f"{obj.name} is {width * 100:.0f} cm wide; the gripper opens {max_opening * 100:.0f} cm")
     # as high as the palm allows (keeps tall things steady), never so low that the pads touch the surface

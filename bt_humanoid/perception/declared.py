@@ -40,13 +40,19 @@ def declared_world_model(world: WorldConfig, model: mujoco.MjModel) -> WorldMode
                 name=name,
                 kind=declared.kind,
                 colour=declared.colour,
-                position=body.pos + (low + high) / 2,
+                position=body.pos + _rotation(body.quat) @ ((low + high) / 2),
                 yaw=2.0 * math.atan2(z, w),
                 size=high - low,
                 keep_upright=declared.upright,
             )
         )
     return belief
+
+
+def _rotation(quat: np.ndarray) -> np.ndarray:
+    matrix = np.zeros(9)
+    mujoco.mju_quat2Mat(matrix, quat)
+    return matrix.reshape(3, 3)
 
 
 def _extents(model: mujoco.MjModel, body: int) -> tuple[np.ndarray, np.ndarray]:

@@ -11,7 +11,7 @@ from pydantic import Field, model_validator
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.whole_body import yaw_rotation
 from bt_humanoid.skills.context import CheckContext
-from bt_humanoid.skills.manipulation_skills import Side, _ManipulationSkill
+from bt_humanoid.skills.manipulation_skills import CARRY_TOLERANCE, Side, _ManipulationSkill
 from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
@@ -91,12 +91,24 @@ class Give(_ManipulationSkill):
         return check_name(params.to, names, "to", "person")
 
     def phases(self):
-        return [("hold out", self._hold_out), ("wait", self._wait), ("let go", self._let_go)]
+        return [
+            ("face the person", self._face),
+            ("hold out", self._hold_out),
+            ("wait", self._wait),
+            ("let go", self._let_go),
+        ]
 
-    def _hold_out(self) -> MotionHandle:
+    def _face(self) -> MotionHandle:
+        """Turn on the spot towards the person: the arm hands things over in front of the body."""
         self.held = self.context.world_model.held(self.params.side)
         if self.held is None:
             raise PhaseFailure(f"the {self.params.side} hand holds nothing to give")
+        x, y, _ = self.context.robot.base.pose()
+        person = self.context.world_model.person(self.params.to)
+        heading = math.atan2(person[1] - y, person[0] - x)
+        return self.context.robot.base.move_to(x, y, heading)
+
+    def _hold_out(self) -> MotionHandle:
         x, y, _ = self.context.robot.base.pose()
         person = self.context.world_model.person(self.params.to)
         direction = person[:2] - np.array([x, y])
@@ -105,7 +117,9 @@ class Give(_ManipulationSkill):
         reach = min(GIVE_REACH, max(distance - 0.3, 0.3))
         position = np.array([x + reach * math.cos(heading), y + reach * math.sin(heading), GIVE_HEIGHT])
         target = pin.SE3(yaw_rotation(heading), position)
-        return self.context.robot.whole_body.reach(self.params.side, target, gaze=person, move_base=False)
+        return self.context.robot.whole_body.reach(
+            self.params.side, target, gaze=person, move_base=False, tolerance=CARRY_TOLERANCE
+        )
 
     def _wait(self) -> MotionHandle:
         # no controller drives this wait: poll() settles the handle from the blackboard and the clock

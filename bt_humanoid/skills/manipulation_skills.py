@@ -63,8 +63,12 @@ class _ManipulationSkill(PhasedSkill):
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
         return math.atan2(rotation[1, 0], rotation[0, 0])
 
-    def _carry(self, side: str, surfaces: list[SupportSurface], extra_limits: list[Limit] = ()) -> MotionHandle:
-        """Bring the hand in front of the body, high enough to carry what it holds past furniture."""
+    def _carry(self, side: str, clearances: list[ClearanceLimit]) -> MotionHandle:
+        """Bring the hand in front of the body, high enough to carry what it holds past furniture.
+
+        ``clearances`` hold the hand up while it is over a surface; the carry
+        pose is at least as high as each, since it may lie over the surface's edge.
+        """
         x, y, yaw = self.context.robot.base.pose()
         lateral = -CARRY_SIDE if side == "right" else CARRY_SIDE
         forward = np.array([math.cos(yaw), math.sin(yaw)])
@@ -74,19 +78,15 @@ class _ManipulationSkill(PhasedSkill):
         held = self.context.world_model.held(side)
         below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
         highest = max((s.height for s in self.context.world_model.surfaces.values()), default=0.0)
-        height = min(max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE), MAX_CARRY_HEIGHT)
+        height = max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE, *(c.height for c in clearances))
         # an empty hand turns to its natural yaw; a full one keeps its yaw (as grasped) so nothing swings
         hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(yaw)
-        target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, height]))
+        target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, min(height, MAX_CARRY_HEIGHT)]))
         return self.context.robot.whole_body.reach(
-            side,
-            target,
-            move_base=False,
-            limits=[*(self._clearance(side, s, 0.0) for s in surfaces), *extra_limits],
-            tolerance=CARRY_TOLERANCE,
+            side, target, move_base=False, limits=list(clearances), tolerance=CARRY_TOLERANCE
         )
 
-    def _clearance(self, side: str, surface: SupportSurface, below_hand: float) -> Limit:
+    def _clearance(self, side: str, surface: SupportSurface, below_hand: float) -> ClearanceLimit:
         """Keep the hand high enough over ``surface`` that ``below_hand`` metres beneath it stay clear."""
         frame = self.context.robot.whole_body.hand_frame(side)
         return ClearanceLimit(frame, surface.height + below_hand + APPROACH_CLEARANCE, surface.region)
@@ -197,7 +197,7 @@ class Grasp(_ManipulationSkill):
             ("check grasp", self._check_grasp),
             ("lift", self._lift),
             ("verify", self._verify),
-            ("carry", lambda: self._carry(self.params.side, [self.surface])),
+            ("carry", lambda: self._carry(self.params.side, [self._clearance(self.params.side, self.surface, 0.0)])),
         ]
 
     def _plan(self) -> None:
@@ -369,7 +369,7 @@ class Put(_ManipulationSkill):
     def _carry_away(self) -> MotionHandle:
         """Back to the carry pose, the pads kept above the placed object while the hand is over the surface."""
         clearance = self._clearance(self.params.side, self.surface, float(self.held.size[2]) + PAD_HALF_HEIGHT)
-        return self._carry(self.params.side, [], extra_limits=[clearance])
+        return self._carry(self.params.side, [clearance])
 
 
 # --------------------------------------------------------------------------- release, look_at, give

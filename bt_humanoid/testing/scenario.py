@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -30,12 +30,21 @@ class Scenario:
         """The statuses one node went through, in order."""
         return [e["new"] for e in self.events if e["event"] == "status" and e["node"] == node]
 
+    def feedback(self, node: str) -> list[str]:
+        """The feedback messages one node reported with its status changes, in order."""
+        return [e.get("feedback", "") for e in self.events if e["event"] == "status" and e["node"] == node]
+
     def final_speed(self) -> float:
         return self.run.robot.max_speed()
 
 
-def build_run(mission: str | Path | dict, seed: int | None = None) -> MissionRun:
-    """A MissionRun from a file path, YAML text or a mission mapping (not yet executed)."""
+def build_run(
+    mission: str | Path | dict, seed: int | None = None, robot_start: tuple[float, float, float] | None = None
+) -> MissionRun:
+    """A MissionRun from a file path, YAML text or a mission mapping (not yet executed).
+
+    ``robot_start`` [x, y, yaw_deg] replaces the world's start pose (test and benchmark set-up).
+    """
     loader = MissionLoader()
     if isinstance(mission, dict):
         spec = loader.load_data(mission)
@@ -43,6 +52,9 @@ def build_run(mission: str | Path | dict, seed: int | None = None) -> MissionRun
         spec = loader.load_file(Path(mission))
     else:
         spec = loader.load_text(mission)
+    if robot_start is not None:
+        world = spec.known.world.model_copy(update={"robot_start": tuple(robot_start)})
+        spec.known = replace(spec.known, world=world)
     return MissionRun(spec, seed=seed)
 
 
