@@ -7,6 +7,8 @@ The executor calls ``step()`` at the control rate; skills send goals through
 
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 
 from bt_humanoid.control.base_driver import BaseDriver
@@ -18,6 +20,14 @@ from bt_humanoid.sim.robot_io import MujocoRobotIO
 from bt_humanoid.sim.simulation import Simulation
 
 REST_SPEED = 0.01  # m/s or rad/s: below this everywhere, the robot is at rest
+
+
+class Planner(Protocol):
+    """Something that streams goals to the controllers every control step (the navigator does)."""
+
+    def step(self) -> None: ...
+
+    def halt(self) -> None: ...
 
 
 class RobotController:
@@ -33,12 +43,17 @@ class RobotController:
         io = self.body_io
         ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
         self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
+        self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
+        self.control_period = 0.01  # s between step() calls; the executor sets it
 
     def set_control_period(self, period: float) -> None:
         """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""
+        self.control_period = period
         self.whole_body.dt = period
 
     def step(self) -> None:
+        for planner in self.planners:
+            planner.step()
         self.whole_body.step()  # streams references first, the controllers below then track them
         self.base.step()
         self.joints.step()
@@ -46,6 +61,8 @@ class RobotController:
 
     def brake(self) -> None:
         """Halt every motion: base and joints decelerate to rest under their limits."""
+        for planner in self.planners:
+            planner.halt()
         self.whole_body.cancel()
         self.base.brake()
         self.joints.brake()

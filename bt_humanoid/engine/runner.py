@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from py_trees.common import Status
 
 from bt_humanoid.control.robot import RobotController
@@ -16,6 +17,7 @@ from bt_humanoid.engine.executor import Executor
 from bt_humanoid.mission.compiler import CompiledMission, Compiler
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.mission.success import ConditionResult, check_condition
+from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.declared import declared_world_model
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
@@ -72,6 +74,8 @@ class MissionRun:
         self.sim = Simulation(world, robot_config)
         self.sim.reset(self.seed if self.seed is not None else header.seed)
         self.robot = RobotController(self.sim)
+        self.navigator = Navigator(self.sim, self.robot, np.array(world.bounds))
+        self.robot.planners.append(self.navigator)
         self.truth = GroundTruth(self.sim)
         self.said: list[str] = []
         safety = header.safety
@@ -94,6 +98,7 @@ class MissionRun:
             blackboard=Blackboard(header.blackboard),
             speak=say,
             world_model=declared_world_model(world, self.sim.model),
+            navigator=self.navigator,
         )
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget

@@ -90,3 +90,6 @@ class WorldModel:
 
     def held(self, side: str) -> TrackedObject | None:
         return next((o for o in self.objects.values() if o.held_by == side), None)
+
+    def held_any(self) -> bool:
+        return any(o.held_by is not None for o in self.objects.values())

@@ -5,6 +5,7 @@ from bt_humanoid.skills import (  # noqa: F401
     blackboard_skills,
     manipulation_skills,
     motion_skills,
+    navigation_skills,
     perception_skills,
     speech_skills,
     timing_skills,

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bt_humanoid.control.robot import RobotController
+from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.world_config import WorldConfig
@@ -51,3 +52,4 @@ class SkillContext(CheckContext):
     blackboard: Blackboard = field(default_factory=Blackboard)
     speak: Callable[[str], None] = print
     world_model: WorldModel = field(default_factory=WorldModel)  # what the robot believes; skills read only this
+    navigator: Navigator | None = None  # plans and follows routes for the base

@@ -1,0 +1,158 @@
+"""Drive the base along a planned route, jerk-limited, facing the way it goes.
+
+Progress along the route (arc length s) and the heading are two degrees of
+freedom of an online Ruckig generator, updated every control step: s heads
+for the end of the route under the speed, acceleration and jerk limits, its
+speed capped ahead of every bend so the sideways acceleration stays small;
+the heading turns towards the direction of travel (and to the goal's yaw for
+the last stretch). The base tracks the route point at s through
+``BaseDriver.track``. A base held back by contact falls behind its
+reference and the motion fails as blocked.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from ruckig import InputParameter, OutputParameter, Result, Ruckig, Synchronization
+
+from bt_humanoid.control.base_driver import BaseDriver, wrap_angle
+from bt_humanoid.control.motion import MotionHandle
+from bt_humanoid.navigation.planner import Route
+from bt_humanoid.sim.robot_config import BaseConfig
+
+LATERAL_ACCEL = 0.4  # m/s^2 allowed sideways in a bend: v ≤ sqrt(a / curvature)
+FINAL_STRETCH = 0.4  # m before the goal from which the base turns to the goal's yaw
+BLOCKED_ERROR = 0.25  # m behind the reference: something holds the base back
+SETTLE_TIMEOUT = 3.0  # s at the end of the route to come within tolerance
+END_EPSILON = 1e-3  # m of the route's end that counts as reached
+
+
+class RouteFollower:
+    """One route at a time; ``step()`` every control period while it runs."""
+
+    def __init__(self, base: BaseDriver, config: BaseConfig, dt: float) -> None:
+        self.base = base
+        self.config = config
+        self.dt = dt
+        self.route: Route | None = None
+        self.handle: MotionHandle | None = None
+        self._otg = Ruckig(2, dt)
+        self._input = InputParameter(2)
+        self._output = OutputParameter(2)
+
+    @property
+    def progress(self) -> float:
+        """Arc length reached along the current route (m)."""
+        return float(self._input.current_position[0]) if self.route is not None else 0.0
+
+    def follow(self, route: Route, max_speed: float) -> MotionHandle:
+        """Start along ``route`` from the base's current state; returns the handle to poll."""
+        if self.handle is not None:
+            self.handle.fail("pre-empted by a new route")
+        limits = self.config.limits
+        pose, speeds = self.base.pose(), self.base.speeds()
+        heading = route.heading(0)
+        along = float(speeds[:2] @ np.array([math.cos(heading), math.sin(heading)]))
+        inp = self._input
+        inp.current_position = [0.0, pose[2]]
+        inp.current_velocity = [max(along, 0.0), speeds[2]]
+        inp.current_acceleration = [0.0, 0.0]
+        inp.max_velocity = [min(max_speed, limits.max_speed), limits.max_yaw_rate]
+        inp.max_acceleration = [limits.max_accel, limits.max_yaw_accel]
+        inp.max_jerk = [limits.max_jerk, limits.max_yaw_jerk]
+        inp.synchronization = Synchronization.No  # progress and heading each as fast as they can
+        self.max_speed = inp.max_velocity[0]
+        self.route = route
+        self.started_settling: float | None = None
+        self.handle = MotionHandle(f"following a {route.length:.1f} m route", on_cancel=lambda _: self.stop())
+        return self.handle
+
+    def stop(self) -> None:
+        """Abandon the route; the base brakes to rest."""
+        if self.route is not None:
+            self.route = None
+            self.base.brake()
+        if self.handle is not None:
+            self.handle.fail("halted: braking")
+            self.handle = None
+
+    def step(self) -> None:
+        route, handle = self.route, self.handle
+        if route is None or handle is None:
+            return
+        inp = self._input
+        s = float(inp.current_position[0])
+        index = int(np.searchsorted(route.arc_length, s))
+        inp.max_velocity = [self._speed_cap(route, s, float(inp.current_velocity[0])), self.config.limits.max_yaw_rate]
+        yaw = self._heading_target(route, s, index)
+        inp.target_position = [route.length, float(inp.current_position[1]) + wrap_angle(yaw - inp.current_position[1])]
+        inp.target_velocity = [0.0, 0.0]
+        result = self._otg.update(inp, self._output)
+        if result not in (Result.Working, Result.Finished):
+            handle.fail(f"route timing failed ({result})")
+            self.stop()
+            return
+        self._output.pass_to_input(inp)
+        s, speed = float(inp.current_position[0]), float(inp.current_velocity[0])
+        point, direction = self._point(route, s)
+        reference = np.array([point[0], point[1], inp.current_position[1]])
+        velocity = np.array([*(speed * direction), inp.current_velocity[1]])
+        self.base.track(reference, velocity)
+        self._check(route, handle, reference, s, speed)
+
+    # ------------------------------------------------------------------ internals
+
+    def _speed_cap(self, route: Route, s: float, speed: float) -> float:
+        """The fastest speed from which every bend within braking distance can still be taken."""
+        limits = self.config.limits
+        horizon = s + speed**2 / (2 * limits.max_accel) + 0.3
+        window = (route.arc_length >= s) & (route.arc_length <= horizon)
+        kappa = float(route.curvature[window].max()) if np.any(window) else 0.0
+        cap = math.sqrt(LATERAL_ACCEL / kappa) if kappa > 1e-6 else self.max_speed
+        return max(min(cap, self.max_speed), 0.05)
+
+    def _heading_target(self, route: Route, s: float, index: int) -> float:
+        if route.length - s < FINAL_STRETCH or route.length < 1e-6:
+            return route.goal_yaw
+        return route.heading(min(index, len(route.points) - 1))
+
+    def _point(self, route: Route, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Route point at arc length s and the unit direction of travel there."""
+        arc = route.arc_length
+        i = int(np.clip(np.searchsorted(arc, s) - 1, 0, max(len(arc) - 2, 0)))
+        if len(arc) < 2:
+            return route.points[0], np.zeros(2)
+        a, b = route.points[i], route.points[i + 1]
+        span = arc[i + 1] - arc[i]
+        t = float(np.clip((s - arc[i]) / span, 0.0, 1.0)) if span > 0 else 1.0
+        return a + t * (b - a), (b - a) / span if span > 0 else np.zeros(2)
+
+    def _check(self, route: Route, handle: MotionHandle, reference: np.ndarray, s: float, speed: float) -> None:
+        pose = self.base.pose()
+        lag = float(np.hypot(*(reference[:2] - pose[:2])))
+        if lag > BLOCKED_ERROR:
+            handle.fail(f"base blocked near ({pose[0]:.2f}, {pose[1]:.2f}): {lag:.2f} m behind its route")
+            self.handle = None
+            self.stop()
+            return
+        goal = route.points[-1]
+        remaining = float(np.hypot(*(goal - pose[:2])))
+        yaw_error = abs(wrap_angle(route.goal_yaw - pose[2]))
+        handle.feedback = f"{max(route.length - s, 0.0):.1f} m of {route.length:.1f} m to go at {speed:.2f} m/s"
+        if route.length - s > END_EPSILON or abs(speed) > 1e-3:
+            return
+        tolerance = self.config.tolerance
+        if remaining < tolerance.position and math.degrees(yaw_error) < tolerance.yaw_deg:
+            handle.succeed(f"arrived within {remaining * 100:.1f} cm, {math.degrees(yaw_error):.1f}°")
+            self.handle = None
+            self.route = None
+            self.base.track(np.array([*goal, route.goal_yaw]), np.zeros(3))  # hold the goal
+            return
+        now = self.base.io.time
+        self.started_settling = self.started_settling if self.started_settling is not None else now
+        if now - self.started_settling > SETTLE_TIMEOUT:
+            handle.fail(f"stopped {remaining:.2f} m and {math.degrees(yaw_error):.0f}° from the goal")
+            self.handle = None
+            self.stop()

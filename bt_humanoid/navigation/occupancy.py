@@ -1,0 +1,95 @@
+"""A 2-D occupancy grid of the floor, and how far every cell is from the nearest obstacle.
+
+Cells are square (``resolution`` metres); cell (row, col) covers
+x ∈ [x0 + col·res, x0 + (col+1)·res), y likewise with rows. Two layers make up
+what is occupied: the static map (furniture and walls, from the scene) and
+what the depth camera saw that the static map does not know (a moved chair,
+a box in the corridor). The clearance field is recomputed when a layer
+changes; planners and followers ask it whether the robot's disc fits.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+class OccupancyGrid:
+    """Static and observed occupancy over a rectangle of the floor, with a clearance field."""
+
+    def __init__(self, bounds: np.ndarray, resolution: float = 0.05) -> None:
+        self.origin = np.asarray(bounds[0], dtype=float)
+        self.resolution = resolution
+        size = np.ceil((np.asarray(bounds[1]) - self.origin) / resolution).astype(int)
+        self.shape = (int(size[1]), int(size[0]))  # rows (y), cols (x)
+        self.static = np.zeros(self.shape, dtype=bool)
+        self.observed = np.zeros(self.shape, dtype=bool)
+        self._clearance: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ geometry
+
+    def cell(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of world points (…, 2); may lie outside the grid."""
+        index = np.floor((np.asarray(xy, dtype=float) - self.origin) / self.resolution).astype(int)
+        return index[..., 1], index[..., 0]
+
+    def centre(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """World (x, y) of cell centres."""
+        return self.origin + (np.stack([cols, rows], axis=-1) + 0.5) * self.resolution
+
+    def inside(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        return (rows >= 0) & (rows < self.shape[0]) & (cols >= 0) & (cols < self.shape[1])
+
+    # ------------------------------------------------------------------ layers
+
+    @property
+    def occupied(self) -> np.ndarray:
+        return self.static | self.observed
+
+    def mark(self, xy: np.ndarray) -> bool:
+        """Mark the cells under world points as seen occupied; True if anything changed."""
+        rows, cols = self.cell(xy)
+        keep = self.inside(rows, cols)
+        rows, cols = rows[keep], cols[keep]
+        new = ~self.observed[rows, cols] & ~self.static[rows, cols]
+        if not np.any(new):
+            return False
+        self.observed[rows[new], cols[new]] = True
+        self._clearance = None
+        return True
+
+    def clear(self, rows: np.ndarray, cols: np.ndarray) -> bool:
+        """Forget observed obstacles in these cells (seen free); True if anything changed."""
+        keep = self.inside(rows, cols)
+        rows, cols = rows[keep], cols[keep]
+        if not np.any(self.observed[rows, cols]):
+            return False
+        self.observed[rows, cols] = False
+        self._clearance = None
+        return True
+
+    def clear_observed(self) -> None:
+        """Forget everything the camera added (the static map stays)."""
+        if np.any(self.observed):
+            self.observed[:] = False
+            self._clearance = None
+
+    # ------------------------------------------------------------------ clearance
+
+    @property
+    def clearance(self) -> np.ndarray:
+        """Metres from each cell centre to the nearest occupied cell (outside the grid counts as occupied)."""
+        if self._clearance is None:
+            free = np.pad(~self.occupied, 1, constant_values=False).astype(np.uint8)
+            distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+            # distance to the nearest occupied cell's centre; its near edge is half a cell closer
+            self._clearance = np.maximum(distance - 0.5, 0.0) * self.resolution
+        return self._clearance
+
+    def clearance_at(self, xy: np.ndarray) -> np.ndarray:
+        """Clearance (m) at world points; 0 outside the grid."""
+        rows, cols = self.cell(xy)
+        inside = self.inside(rows, cols)
+        result = np.zeros(np.shape(rows))
+        result[inside] = self.clearance[rows[inside], cols[inside]]
+        return result

@@ -1,0 +1,224 @@
+"""Skills that move the base with the navigation stack: navigate_to, turn, rotate_in_place, back_up, clear_map.
+
+``navigate_to`` plans around what the map knows (furniture from the scene,
+obstacles the depth camera saw) and replans when the way ahead gets blocked.
+The others are the small moves that recovery is made of (Nav2's spin, back
+up, clear costmap); behaviors/navigate.yaml composes them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from bt_humanoid.control.motion import MotionHandle
+from bt_humanoid.control.stance import StanceError, stance_for
+from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE
+from bt_humanoid.skills.params import check_name
+from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
+from bt_humanoid.skills.registry import skill
+from bt_humanoid.strict_model import StrictModel, exactly_one
+
+LOOK_AHEAD_POSTURE = "look_ahead"  # robot.yaml posture: head level, camera on the way ahead
+OBJECT_STANDOFF = 0.35  # m between the footprint and an object on the floor
+BACK_UP_SPEED = 0.2  # m/s
+
+
+class _BaseSkill(PhasedSkill):
+    def _navigator(self):
+        if self.context.navigator is None:
+            raise PhaseFailure("this robot has no navigation stack")
+        return self.context.navigator
+
+    def _speed(self, requested: float | None) -> float:
+        return min(s for s in (requested, self.context.max_base_speed) if s is not None)
+
+    def _look_ahead(self) -> MotionHandle | None:
+        posture = self.context.robot_config.postures.get(LOOK_AHEAD_POSTURE)
+        return self.context.robot.joints.move(dict(posture)) if posture else None
+
+    def _tuck_arms(self) -> MotionHandle | None:
+        """Fold every empty arm inside the footprint (an arm that carries something keeps its carry pose)."""
+        config = self.context.robot_config
+        tucked = config.postures.get(TUCKED_POSTURE, {})
+        joints = {
+            j: tucked[j]
+            for side in config.grippers
+            if self.context.world_model.held(side) is None
+            for j in config.groups.get(f"{side}_arm", [])
+            if j in tucked
+        }
+        if not self.context.world_model.held_any():  # nothing to hold up: the torso comes down too
+            joints.update({j: 0.0 for j in config.groups.get("lift", [])})
+        return self.context.robot.joints.move(joints) if joints else None
+
+
+class NavigateToParams(StrictModel):
+    place: str | None = Field(None, description="a named place of the world")
+    object: str | None = Field(None, description="an object: a stand-off pose facing it (from the world model)")
+    pose: tuple[float, float, float] | None = Field(None, description="[x, y, yaw_deg] in the world")
+    max_speed: float | None = Field(None, gt=0, le=2.0, description="m/s cap, below the robot's and mission's limits")
+
+    @model_validator(mode="after")
+    def _one_goal(self) -> NavigateToParams:
+        exactly_one(self, "place", "object", "pose")
+        return self
+
+
+@skill("navigate_to", "plan a route around obstacles to a place, an object or a pose, follow it, replan if blocked")
+class NavigateTo(_BaseSkill):
+    Params = NavigateToParams
+
+    @classmethod
+    def check(cls, params: NavigateToParams, context: CheckContext) -> list[tuple[str, str]]:
+        return check_name(params.place, context.world.places, "place", "place") + check_name(
+            params.object, context.world.objects, "object", "object"
+        )
+
+    def phases(self):
+        return [("look ahead", self._look_ahead), ("tuck the arms", self._tuck_arms), ("navigate", self._navigate)]
+
+    def _navigate(self) -> MotionHandle:
+        navigator = self._navigator()
+        goal, what = self._goal()
+        handle = navigator.go_to(goal, self._speed(self.params.max_speed))
+        if handle.done and handle.result:
+            raise PhaseFailure(f"{what}: {handle.result}")
+        self.what = what
+        return handle
+
+    def poll(self):
+        status = super().poll()
+        if status.name == "FAILURE" and hasattr(self, "what") and self.what not in self.feedback_message:
+            self.feedback_message = f"{self.feedback_message} (going to {self.what})"
+        return status
+
+    def _goal(self) -> tuple[np.ndarray, str]:
+        p: NavigateToParams = self.params
+        if p.place is not None:
+            x, y, yaw = self.context.world.place(p.place).pose
+            return np.array([x, y, math.radians(yaw)]), f"place '{p.place}'"
+        if p.pose is not None:
+            x, y, yaw = p.pose
+            return np.array([x, y, math.radians(yaw)]), f"pose ({x:.2f}, {y:.2f}, {yaw:.0f}°)"
+        return self._standoff(p.object), f"the {p.object}"
+
+    def _standoff(self, name: str) -> np.ndarray:
+        """Facing the object: at the nearest edge of the surface it stands on, or beside it on the floor."""
+        belief = self.context.world_model
+        try:
+            obj = belief.object(name)
+        except KeyError as error:
+            raise PhaseFailure(error.args[0]) from None
+        config = self.context.robot_config
+        here = self.context.robot.base.pose()
+        surface = belief.surface_under(obj.position) if obj.held_by is None else None
+        if surface is not None:
+            bounds = np.array(self.context.world.bounds)
+            try:
+                return np.array(
+                    stance_for(obj.position[:2], surface, "right", config.base.footprint_radius, bounds, here[:2])
+                )
+            except StanceError as error:
+                raise PhaseFailure(str(error)) from None
+        away = here[:2] - obj.position[:2]
+        distance = config.base.footprint_radius + OBJECT_STANDOFF
+        direction = away / max(float(np.hypot(*away)), 1e-6)
+        xy = obj.position[:2] + distance * direction
+        return np.array([*xy, math.atan2(-direction[1], -direction[0])])
+
+
+class TurnParams(StrictModel):
+    yaw: float | None = Field(None, ge=-360, le=360, description="heading to turn to (degrees, world)")
+    place: str | None = Field(None, description="a named place to face")
+    object: str | None = Field(None, description="an object to face (from the world model)")
+
+    @model_validator(mode="after")
+    def _one_target(self) -> TurnParams:
+        exactly_one(self, "yaw", "place", "object")
+        return self
+
+
+@skill("turn", "turn on the spot to a heading, or to face a place or an object")
+class Turn(_BaseSkill):
+    Params = TurnParams
+
+    @classmethod
+    def check(cls, params: TurnParams, context: CheckContext) -> list[tuple[str, str]]:
+        return check_name(params.place, context.world.places, "place", "place") + check_name(
+            params.object, context.world.objects, "object", "object"
+        )
+
+    def phases(self):
+        return [("turn", self._turn)]
+
+    def _turn(self) -> MotionHandle:
+        p: TurnParams = self.params
+        x, y, _ = self.context.robot.base.pose()
+        if p.yaw is not None:
+            heading = math.radians(p.yaw)
+        else:
+            if p.place is not None:
+                target = np.array(self.context.world.place(p.place).pose[:2])
+            else:
+                try:
+                    target = self.context.world_model.object(p.object).position[:2]
+                except KeyError as error:
+                    raise PhaseFailure(error.args[0]) from None
+            heading = math.atan2(target[1] - y, target[0] - x)
+        return self.context.robot.base.move_to(x, y, heading)
+
+
+class RotateInPlaceParams(StrictModel):
+    angle: float = Field(360.0, ge=-720, le=720, description="degrees, counter-clockwise (a full turn by default)")
+
+
+@skill("rotate_in_place", "spin on the spot by an angle (lets the camera see all around, to refresh the map)")
+class RotateInPlace(_BaseSkill):
+    Params = RotateInPlaceParams
+
+    def phases(self):
+        return [("look ahead", self._look_ahead), ("rotate", self._rotate)]
+
+    def _rotate(self) -> MotionHandle:
+        x, y, yaw = self.context.robot.base.pose()
+        return self.context.robot.base.move_to(x, y, yaw + math.radians(self.params.angle))
+
+
+class BackUpParams(StrictModel):
+    distance: float = Field(0.3, gt=0, le=2.0, description="metres straight back")
+
+
+@skill("back_up", "drive straight back a short distance, if the map shows room behind")
+class BackUp(_BaseSkill):
+    Params = BackUpParams
+
+    def phases(self):
+        return [("back up", self._back_up)]
+
+    def _back_up(self) -> MotionHandle:
+        navigator = self._navigator()
+        x, y, yaw = self.context.robot.base.pose()
+        behind = np.array([x, y]) - self.params.distance * np.array([math.cos(yaw), math.sin(yaw)])
+        path = np.linspace([x, y], behind, 20)[5:]  # the first points are where the robot stands
+        if np.any(navigator.grid.clearance_at(path) < navigator.clearance.minimum):
+            raise PhaseFailure(f"no room to back up {self.params.distance:.2f} m")
+        return self.context.robot.base.move_to(behind[0], behind[1], yaw, max_speed=BACK_UP_SPEED)
+
+
+class ClearMapParams(StrictModel):
+    pass
+
+
+@skill("clear_map", "forget the obstacles the camera added to the map (the next looks add back what is there)")
+class ClearMap(_BaseSkill):
+    Params = ClearMapParams
+
+    def phases(self):
+        return [("clear", self._clear)]
+
+    def _clear(self) -> None:
+        self._navigator().clear_map()
