@@ -121,6 +121,8 @@ def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
     console.print(f"  tree: {result.tree_status}", highlight=False)
     if result.safety:
         console.print(f"  safety stop: {result.safety}", highlight=False, markup=False)
+    if result.cause:
+        console.print(f"  failed: {result.cause}", highlight=False, markup=False)
     for condition in result.conditions:
         mark = "[green]✔[/]" if condition.holds else "[red]✘[/]"
         console.print(f"  {mark} {condition.condition}: {condition.detail}", highlight=False)

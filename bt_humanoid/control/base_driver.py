@@ -52,14 +52,20 @@ class BaseDriver:
     def speeds(self) -> np.ndarray:
         return self.io.velocities().copy()
 
-    def move_to(self, x: float, y: float, yaw: float, max_speed: float | None = None) -> MotionHandle:
-        """Start driving to a world pose; returns the handle to poll."""
+    def move_to(
+        self, x: float, y: float, yaw: float, max_speed: float | None = None, shortest_turn: bool = True
+    ) -> MotionHandle:
+        """Start driving to a world pose; returns the handle to poll.
+
+        The base turns the short way to ``yaw`` unless ``shortest_turn`` is
+        false: then ``yaw`` is taken literally (yaw + 2π spins a full turn).
+        """
         if self.handle is not None:
             self.handle.fail("pre-empted by a newer goal")
         limits = self.config.limits
         speed = min(max_speed or limits.max_speed, limits.max_speed)
         start = self.reference.copy()
-        target = np.array([x, y, start[2] + wrap_angle(yaw - start[2])])
+        target = np.array([x, y, start[2] + wrap_angle(yaw - start[2]) if shortest_turn else yaw])
         distance = float(np.hypot(*(target[:2] - start[:2])))
         # per-axis limits shaped by the direction so the path stays straight and under the speed cap
         direction = np.abs(target[:2] - start[:2]) / distance if distance > 1e-6 else np.array([0.7, 0.7])

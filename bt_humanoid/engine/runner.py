@@ -22,6 +22,7 @@ from bt_humanoid.perception.declared import declared_world_model
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.simulation import Simulation
+from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.context import Blackboard, SkillContext
 
 
@@ -35,6 +36,7 @@ class RunResult:
     events: EventLog
     said: list[str] = field(default_factory=list)
     safety: str | None = None
+    cause: str | None = None  # the last skill that failed and why, when the tree failed
 
     @property
     def success(self) -> bool:
@@ -51,6 +53,7 @@ class RunResult:
             "tree_status": self.tree_status,
             "conditions": [{"condition": c.condition, "holds": c.holds, "detail": c.detail} for c in self.conditions],
             "safety": self.safety,
+            "cause": self.cause,
             "sim_time": round(self.sim_time, 3),
             "wall_time": round(self.wall_time, 3),
             "real_time_factor": round(self.real_time_factor, 2),
@@ -125,16 +128,26 @@ class MissionRun:
         wall = time.perf_counter() - started
         conditions = [check_condition(c, self.truth) for c in self.spec.header.success]
         violation = self.supervisor.violation
+        tree_status = status.name if status is not Status.INVALID else "FAILURE"
         return RunResult(
             mission=self.spec.header.mission,
-            tree_status=status.name if status is not Status.INVALID else "FAILURE",
+            tree_status=tree_status,
             conditions=conditions,
             sim_time=self.sim.time,
             wall_time=wall,
             events=self.events,
             said=self.said,
             safety=f"{violation.monitor}: {violation.message}" if violation else None,
+            cause=self._failure_cause() if tree_status == "FAILURE" else None,
         )
+
+    def _failure_cause(self) -> str | None:
+        """``path: reason`` of the last skill that failed (a decorator's own message says less)."""
+        skills = {path for node, path in self.compiled.nodes if isinstance(node, Skill)}
+        for event in reversed(self.events.events):
+            if event["event"] == "status" and event["new"] == "FAILURE" and event["node"] in skills:
+                return f"{event['node']}: {event.get('feedback') or 'failed'}"
+        return None
 
 
 def run_mission_file(path: Path, seed: int | None = None) -> RunResult:

@@ -16,6 +16,7 @@ import py_trees
 from py_trees.behaviour import Behaviour
 from py_trees.common import ParallelPolicy
 
+from bt_humanoid.engine.composites import RoundRobin
 from bt_humanoid.engine.decorators import RecoveryPolicy, SafetyGuard, SimTimeout
 from bt_humanoid.mission.schema import RecoverySettings
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
@@ -105,6 +106,8 @@ class Compiler:
             return py_trees.composites.Sequence(label, memory=kind == "sequence", children=children)
         if kind in ("fallback", "reactive_fallback"):
             return py_trees.composites.Selector(label, memory=kind == "fallback", children=children)
+        if kind == "round_robin":
+            return RoundRobin(label, children)
         if kind == "parallel":
             policy = ParallelPolicy.SuccessOnAll() if settings.policy == "all" else ParallelPolicy.SuccessOnOne()
             return py_trees.composites.Parallel(label, policy=policy, children=children)

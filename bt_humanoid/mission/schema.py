@@ -98,6 +98,7 @@ COMPOSITES = {
     "fallback": "children in order until one succeeds; remembers progress",
     "reactive_sequence": "sequence that re-checks earlier children every tick",
     "reactive_fallback": "fallback that re-tries higher-priority children every tick",
+    "round_robin": "one child per run, taking turns (the next run runs the next child); its status is that child's",
 }
 DECORATOR_DESCRIPTIONS = {
     "parallel": "children at once; success by policy",

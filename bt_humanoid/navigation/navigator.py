@@ -65,10 +65,11 @@ class Navigator:
         if self.follower.dt != self.robot.control_period:  # the executor chose the control rate after we were built
             self.follower = RouteFollower(self.robot.base, self.robot.config.base, self.robot.control_period)
         self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), max_speed, 0
-        self.handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
+        handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
+        self.handle = handle
         self._update_map()
-        self._plan_and_follow()
-        return self.handle
+        self._plan_and_follow()  # fails the handle at once if there is no route
+        return handle
 
     def halt(self) -> None:
         """Stop following; the base brakes to rest."""

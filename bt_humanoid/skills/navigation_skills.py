@@ -185,7 +185,7 @@ class RotateInPlace(_BaseSkill):
 
     def _rotate(self) -> MotionHandle:
         x, y, yaw = self.context.robot.base.pose()
-        return self.context.robot.base.move_to(x, y, yaw + math.radians(self.params.angle))
+        return self.context.robot.base.move_to(x, y, yaw + math.radians(self.params.angle), shortest_turn=False)
 
 
 class BackUpParams(StrictModel):

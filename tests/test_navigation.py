@@ -1,0 +1,135 @@
+"""Navigation: the map, OMPL routes, following them, replanning around what the camera sees, recovery as a tree."""
+
+import math
+
+import numpy as np
+import py_trees
+import pytest
+from py_trees.common import Status
+
+from bt_humanoid.cli import run_main
+from bt_humanoid.engine.composites import RoundRobin
+from bt_humanoid.navigation.planner import Clearance, PlanError, plan_route
+from bt_humanoid.testing.scenario import Scenario, build_run
+
+PLACES = {"table": (2.4, 0.0), "counter": (7.75, 2.5), "shelf": (1.2, 3.45), "kitchen": (7.0, 2.4)}
+
+
+@pytest.fixture(scope="module")
+def idle_run():
+    return build_run({"mission": "idle", "tree": {"wait": {"seconds": 0}}})
+
+
+def test_static_map_holds_the_furniture_and_leaves_room_at_the_named_places(idle_run):
+    grid = idle_run.navigator.grid
+    for furniture in [(3.4, 0.0), (8.55, 2.5), (1.4, 0.0), (2.6, 1.7), (1.2, 4.25)]:  # table, counter, box, chair, shelf
+        assert grid.clearance_at(np.array([furniture]))[0] == 0.0, furniture
+    needed = idle_run.navigator.clearance.minimum
+    for name, place in PLACES.items():
+        assert grid.clearance_at(np.array([place]))[0] >= needed, name
+    assert grid.clearance_at(np.array([[3.4, 0.0]]))[0] == 0.0
+    assert not grid.static[grid.cell(np.array([[8.6, -4.15]]))].any(), "a free body (the parcel) is not on the map"
+
+
+@pytest.mark.parametrize(
+    ("start", "goal"),
+    [((0.0, 0.0, 0.0), (7.0, 2.4, 0.0)), ((5.0, 3.5, 0.0), (0.5, -2.4, -1.57)), ((8.0, -3.0, 0.0), (1.2, 3.45, 1.57))],
+)
+def test_routes_go_around_the_furniture_with_room_to_spare(idle_run, start, goal):
+    navigator = idle_run.navigator
+    route = plan_route(navigator.grid, np.array(start), np.array(goal), navigator.clearance)
+    assert np.allclose(route.points[0], start[:2]) and np.allclose(route.points[-1], goal[:2])
+    assert np.all(np.hypot(*np.diff(route.points, axis=0).T) < 0.06), "dense: every 5 cm"
+    free = navigator.grid.clearance_at(route.points)
+    assert free.min() >= navigator.clearance.minimum
+    middle = np.minimum(*(np.hypot(*(route.points - np.array(end[:2])).T) for end in (start, goal))) > 0.6
+    assert free[middle].min() >= navigator.clearance.preferred
+
+
+def test_a_goal_inside_an_obstacle_is_refused_with_its_position(idle_run):
+    navigator = idle_run.navigator
+    with pytest.raises(PlanError, match=r"goal \(3\.40, 0\.00\) is inside an obstacle"):
+        plan_route(navigator.grid, np.zeros(3), np.array([3.4, 0.0, 0.0]), navigator.clearance)
+
+
+def test_a_walled_off_goal_is_refused(idle_run):
+    grid = idle_run.navigator.grid
+    angles = np.linspace(0, 2 * math.pi, 400)
+    ring = np.array([5.0, -2.0]) + 0.8 * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    try:
+        grid.mark(ring)  # as if the camera had seen a closed fence around (5, -2)
+        with pytest.raises(PlanError, match="walled off"):
+            plan_route(grid, np.zeros(3), np.array([5.0, -2.0, 0.0]), Clearance(0.34, 0.42), time_limit=0.2)
+    finally:
+        grid.clear_observed()
+
+
+def _watch_contacts(run) -> list:
+    contacts: list = []
+    run.executor.observers.append(lambda: contacts.extend(run.truth.robot_contacts()))
+    return contacts
+
+
+def test_navigate_to_arrives_at_the_kitchen_without_touching_anything():
+    run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
+    contacts = _watch_contacts(run)
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    x, y, yaw = scenario.truth.robot_pose()
+    assert math.hypot(x - 7.0, y - 2.4) <= 0.05
+    assert abs(math.degrees(yaw)) <= 5.0
+    assert contacts == []
+
+
+def test_a_parcel_dropped_on_the_route_is_seen_and_driven_around():
+    run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
+    navigator = run.navigator
+    parcel = run.sim.model.joint("parcel").qposadr[0]
+    dropped: list[np.ndarray] = []
+
+    def drop_the_parcel_ahead() -> None:
+        # the fault: 1.5 m into the drive, a parcel lands on the route 1.8 m ahead of the robot
+        route = navigator.route
+        if dropped or route is None or navigator.follower.progress < 1.5:
+            return
+        ahead = route.points[np.searchsorted(route.arc_length, navigator.follower.progress + 1.8)]
+        run.sim.data.qpos[parcel : parcel + 3] = [ahead[0], ahead[1], 0.16]
+        run.sim.data.qvel[run.sim.model.joint("parcel").dofadr[0] : run.sim.model.joint("parcel").dofadr[0] + 6] = 0
+        dropped.append(ahead)
+
+    run.executor.observers.append(drop_the_parcel_ahead)
+    contacts = _watch_contacts(run)
+    scenario = Scenario(run, run.execute())
+    assert dropped, "the fault was never injected"
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    assert len(navigator.planning_times) >= 2, "it replanned"
+    assert navigator.grid.observed[navigator.grid.cell(dropped[0][None, :])].all(), "the camera put it on the map"
+    assert not any("parcel" in other for _, other in contacts)
+    x, y, _ = scenario.truth.robot_pose()
+    assert math.hypot(x - 7.0, y - 2.4) <= 0.05
+
+
+def test_a_goal_in_the_table_ends_after_bounded_recovery_naming_the_goal(tmp_path, capsys):
+    mission = tmp_path / "into_the_table.yaml"
+    mission.write_text("mission: drive into the table\ntree:\n  navigate: {pose: [3.4, 0.0, 0]}\n")
+    assert run_main([str(mission), "--no-live"]) == 1
+    out = capsys.readouterr().out
+    assert "failed: navigate>retry.fallback[0].navigate_to" in out
+    assert "goal (3.40, 0.00) is inside an obstacle" in out
+    for recovery in ("clear_map", "rotate_in_place", "back_up", "wait"):
+        assert f"round_robin[{['clear_map', 'rotate_in_place', 'back_up', 'wait'].index(recovery)}].{recovery}" in out
+
+
+def test_round_robin_runs_the_next_child_each_time():
+    ran: list[str] = []
+
+    class Mark(py_trees.behaviour.Behaviour):
+        def update(self) -> Status:
+            ran.append(self.name)
+            return Status.SUCCESS
+
+    node = RoundRobin("turns", [Mark("a"), Mark("b"), Mark("c")])
+    for _ in range(4):
+        node.tick_once()
+        assert node.status is Status.SUCCESS
+    assert ran == ["a", "b", "c", "a"]
