@@ -175,13 +175,13 @@ def validate_file(file: Path) -> str:
 
 
 def _default_args(behavior) -> dict:
-    """Arguments that satisfy a behaviour's required parameters, for checking its tree on its own."""
+    """Arguments for checking a behaviour's tree on its own: its example, and a sample for any other required one."""
     samples = {str: "x", float: 0.0, int: 0, bool: False}
     args = {}
     for name, field in behavior.args_model.model_fields.items():
         if field.is_required():
             args[name] = samples.get(field.annotation, "x")
-    return args
+    return {**args, **behavior.example}
 
 
 def validate_main(argv: list[str] | None = None) -> int:

@@ -22,8 +22,9 @@ def idle_run():
 
 def test_static_map_holds_the_furniture_and_leaves_room_at_the_named_places(idle_run):
     grid = idle_run.navigator.grid
-    for furniture in [(3.4, 0.0), (8.55, 2.5), (1.4, 0.0), (2.6, 1.7), (1.2, 4.25)]:  # table, counter, box, chair, shelf
-        assert grid.clearance_at(np.array([furniture]))[0] == 0.0, furniture
+    furniture = {"table": (3.4, 0), "counter": (8.55, 2.5), "box": (1.4, 0), "chair": (2.6, 1.7), "shelf": (1.2, 4.25)}
+    for name, xy in furniture.items():
+        assert grid.clearance_at(np.array([xy]))[0] == 0.0, name
     needed = idle_run.navigator.clearance.minimum
     for name, place in PLACES.items():
         assert grid.clearance_at(np.array([place]))[0] >= needed, name

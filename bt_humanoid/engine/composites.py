@@ -30,8 +30,7 @@ class RoundRobin(py_trees.composites.Composite):
             self.turn += 1
             self.initialise()
         child = self.current_child
-        for node in child.tick():
-            yield node
+        yield from child.tick()
         if child.status != Status.RUNNING:
             self.stop(child.status)
         else:

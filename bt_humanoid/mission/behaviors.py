@@ -8,7 +8,7 @@ is replaced by the argument when the behaviour is expanded (a whole-value
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
@@ -34,6 +34,7 @@ class BehaviorHeader(StrictModel):
     behavior: str = Field(pattern=r"^[a-z][a-z0-9_]*$")
     description: str = ""
     params: dict[str, BehaviorParam] = Field(default_factory=dict)
+    example: dict[str, Any] = Field(default_factory=dict)  # arguments of a typical call; used to check the tree
     tree: Any
 
 
@@ -43,6 +44,7 @@ class Behavior:
     description: str
     source: YamlSource
     args_model: type[BaseModel]
+    example: dict[str, Any] = field(default_factory=dict)
 
 
 def _args_model(name: str, header: BehaviorHeader) -> type[BaseModel]:
@@ -67,7 +69,7 @@ def load_behavior(file: Path) -> Behavior:
     except ValidationError as error:
         location, message = describe_validation_error(error)
         raise UserError(message, where=source.where(location)) from None
-    return Behavior(header.behavior, header.description, source, _args_model(header.behavior, header))
+    return Behavior(header.behavior, header.description, source, _args_model(header.behavior, header), header.example)
 
 
 class BehaviorLibrary:
