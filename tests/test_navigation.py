@@ -104,7 +104,10 @@ def test_a_parcel_dropped_on_the_route_is_seen_and_driven_around():
     assert dropped, "the fault was never injected"
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
     assert len(navigator.planning_times) >= 2, "it replanned"
-    assert navigator.grid.observed[navigator.grid.cell(dropped[0][None, :])].all(), "the camera put it on the map"
+    grid = navigator.grid
+    seen = grid.centre(*np.nonzero(grid.observed))
+    on_parcel = np.all(np.abs(seen - dropped[0]) <= 0.2, axis=1)
+    assert on_parcel.sum() >= 3, "the camera put the parcel on the map"
     assert not any("parcel" in other for _, other in contacts)
     x, y, _ = scenario.truth.robot_pose()
     assert math.hypot(x - 7.0, y - 2.4) <= 0.05

@@ -26,7 +26,7 @@ from bt_humanoid.sim.simulation import Simulation
 
 RESOLUTION = 0.05  # m per map cell
 CLEARANCE_MARGIN = 0.1  # m the base keeps from obstacles on the way, beyond its footprint
-END_MARGIN = 0.02  # m near the start and goal (stances at furniture are close to it)
+END_MARGIN = 0.0  # m near the start and goal: stances at furniture are close to it (the grid errs on the safe side)
 OBSTACLE_MIN_HEIGHT = 0.06  # m: depth points lower than this are floor
 FREE_BELOW = 0.1  # m: a ray passing a cell lower than this shows nothing taller stands there
 OWN_SPACE = 0.6  # m around the base centre where depth points are the robot or what it carries
@@ -54,6 +54,7 @@ class Navigator:
         self.replans = 0
         self.handle: MotionHandle | None = None
         self.planning_times: list[float] = []  # s of wall time per plan, for benchmarks
+        self.route_lengths: list[float] = []  # m, per route planned
         self.route: Route | None = None
         self.motion: MotionHandle | None = None  # the follower's handle for the current route
 
@@ -117,6 +118,7 @@ class Navigator:
             self._finish_goal(str(error), brake=True)
             return
         self.planning_times.append(route.planning_time)
+        self.route_lengths.append(route.length)
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
 
@@ -168,7 +170,9 @@ class Navigator:
         directions, ranges = scan.directions[usable], scan.ranges[usable]
         # a downward ray is below FREE_BELOW from t_low on; it saw free floor from there to its end
         t_low = np.maximum((scan.origin[2] - FREE_BELOW) / -directions[:, 2], 0.0)
-        t_end = ranges - self.grid.resolution
+        # stop 1.5 cells short of the hit, measured on the floor: the hit cell itself holds what was hit
+        horizontal = np.maximum(np.hypot(directions[:, 0], directions[:, 1]), 1e-3)
+        t_end = ranges - 1.5 * self.grid.resolution / horizontal
         fraction = np.linspace(0.0, 1.0, FREE_SAMPLES)
         t = t_low[:, None] + (t_end - t_low)[:, None] * fraction[None, :]
         keep = np.broadcast_to((t_end > t_low)[:, None], t.shape)

@@ -23,6 +23,9 @@ from ompl import util as ou
 from bt_humanoid.navigation.occupancy import OccupancyGrid
 
 ou.setLogLevel(ou.LogLevel.LOG_WARN)
+# OMPL seeds its random numbers once per process, before the first plan: a fixed seed makes a run of
+# the same mission plan the same routes (DESIGN: same mission and seed, same event log)
+ou.RNG.setSeed(1)
 
 SAMPLE_SPACING = 0.05  # m between points of a planned route
 CORNER_RADIUS = 0.5  # m: the largest arc a corner is rounded with
@@ -140,7 +143,7 @@ def _ompl_route(grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, valid,
         state = space.allocState()
         state.setX(float(pose[0]))
         state.setY(float(pose[1]))
-        state.setYaw(float(pose[2]))
+        state.setYaw(math.remainder(float(pose[2]), 2 * math.pi))  # SO(2) states live in [-π, π]
         states.append(state)
     setup.setStartAndGoalStates(states[0], states[1])
     setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
