@@ -137,3 +137,11 @@ def test_round_robin_runs_the_next_child_each_time():
         node.tick_once()
         assert node.status is Status.SUCCESS
     assert ran == ["a", "b", "c", "a"]
+
+
+def test_the_tour_visits_every_leg_and_ends_in_the_living_room(run_mission, project_root):
+    scenario = run_mission(project_root / "missions" / "tour.yaml")
+    assert scenario.result.success, scenario.result.summary()
+    arrived = [e for e in scenario.events if e["event"] == "status" and e["new"] == "SUCCESS"]
+    assert sum(1 for e in arrived if e["node"].endswith("navigate_to")) == 4
+    assert scenario.truth.robot_contacts() == []
