@@ -31,7 +31,7 @@ from bt_humanoid.navigation.grid_astar import grid_route_length
 from bt_humanoid.testing.scenario import build_run
 
 GOALS = ("table", "counter", "shelf", "kitchen", "living_room")
-START_CLEARANCE = 0.5  # m of free floor around a random start
+START_CLEARANCE = 0.8  # m of free floor around a random start: the arms of the home posture reach 0.7 m
 POSITION_TOLERANCE = 0.05  # m
 HEADING_TOLERANCE = 5.0  # degrees
 SPEED = 0.8  # m/s cap for the drive

@@ -2,8 +2,10 @@
 
 The base is a disc, so a pose is valid when the clearance field of the
 occupancy grid says the disc (plus a margin) fits there; yaw is free and the
-follower turns the robot along the route. RRT-Connect finds a route, OMPL's
-simplifier shortens it, and every remaining corner becomes a circular arc
+follower turns the robot along the route. A straight line is used when it is
+free. Otherwise BIT* (optimising length) finds a route, RRT-Connect standing
+by if it finds none in its budget; the route is pulled taut (shortcuts
+between its points) and every remaining corner becomes a circular arc
 (smaller where an arc would come too close to an obstacle), so the follower
 can keep moving through it.
 """
@@ -30,7 +32,7 @@ ou.RNG.setSeed(1)
 SAMPLE_SPACING = 0.05  # m between points of a planned route
 CORNER_RADIUS = 0.5  # m: the largest arc a corner is rounded with
 NEAR_ENDS = 0.5  # m around the start and goal where the smaller clearance applies
-ATTEMPTS = 3  # RRT-Connect solutions to choose the shortest from
+OPTIMISE_TIME = 0.1  # s of wall time BIT* spends shortening a route (it stops early if the way is open)
 
 
 class PlanError(RuntimeError):
@@ -112,20 +114,26 @@ def plan_route(
     if _segment_valid(start_xy, goal_xy, valid_points):
         corners = np.array([start_xy, goal_xy])  # straight line: no sampling needed
     else:
-        # RRT-Connect finds a way around the obstacles, not a short one: pull each solution taut (shortcut
-        # its densified path) and keep the shortest of a few, as they may pass obstacles on different sides
-        candidates = []
-        for _ in range(ATTEMPTS):
-            solution = _ompl_route(grid, start, goal, lambda state: valid_xy(state.getX(), state.getY()), time_limit)
-            candidates.append(_shortcut(_densify(solution, 0.25), valid_points))
-        corners = min(candidates, key=lambda c: float(np.sum(np.hypot(*np.diff(c, axis=0).T))))
+        # BIT* (optimising path length) finds the short way round within a small budget; RRT-Connect is the
+        # fallback that keeps looking (a goal it cannot reach in time_limit is walled off)
+        state_valid = lambda state: valid_xy(state.getX(), state.getY())  # noqa: E731
+        solution = _ompl_route(grid, start, goal, state_valid, og.BITstar, OPTIMISE_TIME, optimise=True)
+        if solution is None:
+            solution = _ompl_route(grid, start, goal, state_valid, og.RRTConnect, time_limit)
+        if solution is None:
+            where = f"({goal[0]:.2f}, {goal[1]:.2f})"
+            raise PlanError(f"no route to {where} within {time_limit:.1f} s of planning: it may be walled off")
+        corners = _shortcut(_densify(solution, 0.25), valid_points)
     points, curvature = _round_corners(corners, valid_points)
     steps = np.hypot(*np.diff(points, axis=0).T)
     arc = np.concatenate([[0.0], np.cumsum(steps)])
     return Route(points, arc, curvature, float(goal[2]), time.perf_counter() - started)
 
 
-def _ompl_route(grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, valid, time_limit: float) -> np.ndarray:
+def _ompl_route(
+    grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, valid, planner, time_limit: float, optimise: bool = False
+) -> np.ndarray | None:
+    """Corner points of an OMPL solution in SE(2), or None if there is none within ``time_limit`` s."""
     space = ob.SE2StateSpace()
     bounds = ob.RealVectorBounds(2)
     high = grid.origin + np.array(grid.shape[::-1]) * grid.resolution
@@ -135,9 +143,9 @@ def _ompl_route(grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, valid,
     space.setBounds(bounds)
     setup = og.SimpleSetup(space)
     setup.setStateValidityChecker(valid)
+    information = setup.getSpaceInformation()
     # check motions every half cell: no thin wall is skipped between two valid states
-    extent = space.getMaximumExtent()
-    setup.getSpaceInformation().setStateValidityCheckingResolution(0.5 * grid.resolution / extent)
+    information.setStateValidityCheckingResolution(0.5 * grid.resolution / space.getMaximumExtent())
     states = []
     for pose in (start, goal):
         state = space.allocState()
@@ -146,13 +154,12 @@ def _ompl_route(grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, valid,
         state.setYaw(math.remainder(float(pose[2]), 2 * math.pi))  # SO(2) states live in [-π, π]
         states.append(state)
     setup.setStartAndGoalStates(states[0], states[1])
-    setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
-    solved = setup.solve(time_limit)
+    if optimise:
+        setup.setOptimizationObjective(ob.PathLengthOptimizationObjective(information))
+    setup.setPlanner(planner(information))
+    setup.solve(time_limit)
     if not setup.haveExactSolutionPath():
-        raise PlanError(
-            f"no route to ({goal[0]:.2f}, {goal[1]:.2f}) within {time_limit:.1f} s of planning ({solved}): "
-            "it may be walled off"
-        )
+        return None
     path = setup.getSolutionPath()  # every motion of it was checked; _shortcut simplifies it
     return np.array([[path.getState(i).getX(), path.getState(i).getY()] for i in range(path.getStateCount())])
 
