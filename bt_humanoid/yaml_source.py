@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -66,15 +67,32 @@ def read_yaml(file: Path, text: str | None = None) -> YamlSource:
         loader.dispose()
 
 
-def read_config(kind: str, folder: Path, name: str, filename: str, model: type[BaseModel]) -> BaseModel:
-    """Read ``folder/name/filename`` (a robot.yaml or world.yaml) into ``model``, errors at file:line."""
+def read_config(
+    kind: str,
+    folder: Path,
+    name: str,
+    filename: str,
+    model: type[BaseModel],
+    inherit: Callable[[Any], dict] | None = None,
+) -> BaseModel:
+    """Read ``folder/name/filename`` (a robot.yaml or world.yaml) into ``model``, errors at file:line.
+
+    With ``inherit``, the file may say ``extends: OTHER``: ``inherit(OTHER's config)`` gives the keys it
+    starts from, and its own keys override them.
+    """
     path = folder / name / filename
     if not path.is_file():
         valid = sorted(p.name for p in folder.iterdir() if (p / filename).is_file()) if folder.is_dir() else []
         raise UserError(f"unknown {kind} '{name}'", hint=did_you_mean(name, valid))
     source = read_yaml(path)
+    data = dict(source.data or {}) if isinstance(source.data, dict) else source.data
+    if inherit is not None and isinstance(data, dict) and "extends" in data:
+        parent = data.pop("extends")
+        if not isinstance(parent, str) or parent == name:
+            raise UserError(f"extends: the name of another {kind}", where=source.where(("extends",)))
+        data = {**inherit(read_config(kind, folder, parent, filename, model, inherit)), **data}
     try:
-        return model.model_validate({**(source.data or {}), "folder": path.parent})
+        return model.model_validate({**(data or {}), "folder": path.parent})
     except ValidationError as error:
         location, message = describe_validation_error(error)
         raise UserError(message, where=source.where(location)) from None

@@ -145,3 +145,30 @@ def test_the_tour_visits_every_leg_and_ends_in_the_living_room(run_mission, proj
     arrived = [e for e in scenario.events if e["event"] == "status" and e["new"] == "SUCCESS"]
     assert sum(1 for e in arrived if e["node"].endswith("navigate_to")) == 4
     assert scenario.truth.robot_contacts() == []
+
+
+def test_a_world_can_extend_another_and_add_a_walking_person():
+    run = build_run({"mission": "idle", "world": "apartment_busy", "tree": {"wait": {"seconds": 2}}})
+    world = run.context.world
+    assert set(PLACES) <= set(world.places) and "walker" in world.walkers
+    start = run.sim.walkers[0].position().copy()
+    run.execute()
+    walked = float(np.hypot(*(run.sim.walkers[0].position() - start)))
+    assert 0.6 < walked <= 1.05  # 2 s at 0.5 m/s, driven by its actuators
+    assert not run.navigator.grid.static[run.navigator.grid.cell(start[None, :])].any(), "people are not on the map"
+
+
+def test_crossing_the_walking_persons_loop_never_touches_them():
+    mission = {"mission": "cross", "world": "apartment_busy", "tree": {"navigate": {"place": "kitchen"}}}
+    run = build_run(mission, robot_start=(3.6, -1.5, 0.0))  # south of the table, the person's loop ahead
+    contacts = _watch_contacts(run)
+    apart: list[float] = []
+    run.executor.observers.append(
+        lambda: apart.append(float(np.hypot(*(run.truth.robot_pose()[:2] - run.sim.walkers[0].position()))))
+    )
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    assert min(apart) < 1.5, "their ways crossed (the person is 0.2 m in radius, the robot 0.32 m)"
+    assert not [c for c in contacts if "walker" in c[1]]
+    x, y, _ = scenario.truth.robot_pose()
+    assert math.hypot(x - 7.0, y - 2.4) <= 0.05

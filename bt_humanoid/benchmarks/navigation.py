@@ -53,21 +53,36 @@ class Outcome:
     failure: str | None
 
 
-def random_starts(count: int, rng: np.random.Generator) -> list[tuple[float, float, float]]:
-    """Free poses (x, y, yaw_deg) spread over the apartment."""
-    probe = build_run({"mission": "probe", "tree": {"wait": {"seconds": 0}}})
+def random_starts(count: int, rng: np.random.Generator, world: str = "apartment") -> list[tuple[float, float, float]]:
+    """Free poses (x, y, yaw_deg) spread over the apartment (away from any walker's loop)."""
+    probe = build_run({"mission": "probe", "world": world, "tree": {"wait": {"seconds": 0}}})
     grid = probe.navigator.grid
     (x0, y0), (x1, y1) = probe.context.world.bounds
     starts = []
     while len(starts) < count:
         xy = np.array([rng.uniform(x0, x1), rng.uniform(y0, y1)])
-        if grid.clearance_at(xy[None, :])[0] >= START_CLEARANCE:
+        if grid.clearance_at(xy[None, :])[0] >= START_CLEARANCE and _clear_of_walkers(xy, probe.context.world):
             starts.append((round(float(xy[0]), 3), round(float(xy[1]), 3), round(float(rng.uniform(-180, 180)), 1)))
     return starts
 
 
-def run_one(start: tuple[float, float, float], goal: str) -> Outcome:
-    mission = {"mission": f"navigate to the {goal}", "tree": {"navigate": {"place": goal, "speed": SPEED}}}
+def _clear_of_walkers(xy: np.ndarray, world) -> bool:
+    """At least START_CLEARANCE from every leg of every walker's loop (nobody starts inside a person)."""
+    for walker in world.walkers.values():
+        corners = np.array(walker.route)
+        for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+            t = np.clip((xy - a) @ (b - a) / max(float((b - a) @ (b - a)), 1e-9), 0.0, 1.0)
+            if np.hypot(*(xy - (a + t * (b - a)))) < START_CLEARANCE + walker.radius:
+                return False
+    return True
+
+
+def run_one(start: tuple[float, float, float], goal: str, world: str = "apartment") -> Outcome:
+    mission = {
+        "mission": f"navigate to the {goal}",
+        "world": world,
+        "tree": {"navigate": {"place": goal, "speed": SPEED}},
+    }
     run = build_run(mission, robot_start=start)
     contacts: list[tuple[str, str]] = []
     track: list[tuple[float, np.ndarray, float]] = []
@@ -120,6 +135,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--starts", type=int, default=20, help="random start poses (default 20)")
     parser.add_argument("--goals", nargs="+", choices=GOALS, default=list(GOALS), help="named goals")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the start poses (default 0)")
+    parser.add_argument(
+        "--world", default="apartment", help="apartment, or apartment_busy (a person walks a loop across the middle)"
+    )
     parser.add_argument("--json", type=Path, help="also write the figures here")
     args = parser.parse_args(argv)
     if args.starts < 1:
@@ -127,13 +145,16 @@ def main(argv: list[str] | None = None) -> int:
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     started = time.perf_counter()
-    starts = random_starts(args.starts, np.random.default_rng(args.seed))
+    starts = random_starts(args.starts, np.random.default_rng(args.seed), args.world)
     total = len(starts) * len(args.goals)
-    print(f"bt-humanoid navigation benchmark: {len(starts)} starts × {len(args.goals)} goals, seed {args.seed}")
+    print(
+        f"bt-humanoid navigation benchmark in {args.world}: {len(starts)} starts × {len(args.goals)} goals, "
+        f"seed {args.seed}"
+    )
     outcomes = []
     for start in starts:
         for goal in args.goals:
-            outcome = run_one(start, goal)
+            outcome = run_one(start, goal, args.world)
             outcomes.append(outcome)
             verdict = "ok" if outcome.success else f"FAILED: {outcome.failure}"
             speed = outcome.distance / outcome.drive_time if outcome.drive_time > 0 else 0.0

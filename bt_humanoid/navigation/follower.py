@@ -27,6 +27,7 @@ FINAL_STRETCH = 0.4  # m before the goal from which the base turns to the goal's
 BLOCKED_ERROR = 0.25  # m behind the reference: something holds the base back
 SETTLE_TIMEOUT = 3.0  # s at the end of the route to come within tolerance
 END_EPSILON = 1e-3  # m of the route's end that counts as reached
+STOP_SHORT = 0.3  # m the base stops short of where its route is blocked
 
 
 class RouteFollower:
@@ -38,6 +39,7 @@ class RouteFollower:
         self.dt = dt
         self.route: Route | None = None
         self.handle: MotionHandle | None = None
+        self.stop_at: float | None = None  # arc length where the route is blocked: stop short of it
         self._otg = Ruckig(2, dt)
         self._input = InputParameter(2)
         self._output = OutputParameter(2)
@@ -66,6 +68,7 @@ class RouteFollower:
         self.max_speed = inp.max_velocity[0]
         self.route = route
         self.started_settling: float | None = None
+        self.stop_at = None
         self.handle = MotionHandle(f"following a {route.length:.1f} m route", on_cancel=lambda _: self.stop())
         return self.handle
 
@@ -87,7 +90,8 @@ class RouteFollower:
         index = int(np.searchsorted(route.arc_length, s))
         inp.max_velocity = [self._speed_cap(route, s, float(inp.current_velocity[0])), self.config.limits.max_yaw_rate]
         yaw = self._heading_target(route, s, index)
-        inp.target_position = [route.length, float(inp.current_position[1]) + wrap_angle(yaw - inp.current_position[1])]
+        end = route.length if self.stop_at is None else min(route.length, max(s, self.stop_at - STOP_SHORT))
+        inp.target_position = [end, float(inp.current_position[1]) + wrap_angle(yaw - inp.current_position[1])]
         inp.target_velocity = [0.0, 0.0]
         result = self._otg.update(inp, self._output)
         if result not in (Result.Working, Result.Finished):
@@ -111,6 +115,9 @@ class RouteFollower:
         window = (route.arc_length >= s) & (route.arc_length <= horizon)
         kappa = float(route.curvature[window].max()) if np.any(window) else 0.0
         cap = math.sqrt(LATERAL_ACCEL / kappa) if kappa > 1e-6 else self.max_speed
+        if self.stop_at is not None:  # something ahead: slow so the base can stop short of it
+            room = max(self.stop_at - STOP_SHORT - s, 0.0)
+            cap = min(cap, math.sqrt(2 * limits.max_accel * room))
         return max(min(cap, self.max_speed), 0.05)
 
     def _heading_target(self, route: Route, s: float, index: int) -> float:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 
 from bt_humanoid.control.motion import MotionHandle
@@ -29,9 +30,15 @@ CLEARANCE_MARGIN = 0.1  # m the base keeps from obstacles on the way, beyond its
 END_MARGIN = 0.0  # m near the start and goal: stances at furniture are close to it (the grid errs on the safe side)
 OBSTACLE_MIN_HEIGHT = 0.06  # m: depth points lower than this are floor
 FREE_BELOW = 0.1  # m: a ray passing a cell lower than this shows nothing taller stands there
-OWN_SPACE = 0.6  # m around the base centre where depth points are the robot or what it carries
+OWN_MARGIN = 0.03  # m beyond the footprint where depth points are the robot's own bumper
+HELD_RADIUS = 0.15  # m around a hand where points below it are what it holds
+SEEN_DEPTH = 0.3  # m an obstacle is assumed to extend behind the face the camera sees (a person, a parcel)
+OBSERVED_PADDING = 0.2  # m more room given to what the camera saw than to the furniture: it may move
+GAZE_AHEAD = 1.5  # m along the route where the head looks
+MAX_GAZE_PAN = 1.0  # rad the head turns from the heading at most
 LOOKAHEAD = 2.5  # m of route ahead checked against the map at every update
-MAX_REPLANS = 5  # per goal, before the goal fails as blocked
+MAX_REPLANS = 30  # per goal, before the goal fails as blocked
+WAIT_LIMIT = 15.0  # s to wait, stopped, for a blocked way to clear before the goal fails
 FREE_SAMPLES = 12  # points along the low end of each ray that mark free cells
 
 
@@ -44,11 +51,15 @@ class Navigator:
         footprint = config.base.footprint_radius
         self.clearance = Clearance(footprint + END_MARGIN, footprint + CLEARANCE_MARGIN)
         self.grid: OccupancyGrid = static_map(sim.model, sim.data, bounds, RESOLUTION)
+        self.grid.observed_padding = OBSERVED_PADDING
+        # a hit on a face of the furniture may fall in the cell just outside it: that is the furniture too
+        self._near_static = cv2.dilate(self.grid.static.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
         camera = next(iter(config.cameras), None)
         self.camera = DepthCamera(sim.model, sim.data, camera, "base") if camera else None
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
         self.last_scan = -math.inf
         self.follower = RouteFollower(robot.base, config.base, robot.control_period)
+        self.head_pan = next((j for j in config.groups.get("head", []) if "pan" in j), None)
         self.goal: np.ndarray | None = None
         self.max_speed = config.base.limits.max_speed
         self.replans = 0
@@ -57,6 +68,7 @@ class Navigator:
         self.route_lengths: list[float] = []  # m, per route planned
         self.route: Route | None = None
         self.motion: MotionHandle | None = None  # the follower's handle for the current route
+        self.waiting_since: float | None = None  # stopped because no route is free now
 
     # ------------------------------------------------------------------ goals
 
@@ -66,6 +78,7 @@ class Navigator:
         if self.follower.dt != self.robot.control_period:  # the executor chose the control rate after we were built
             self.follower = RouteFollower(self.robot.base, self.robot.config.base, self.robot.control_period)
         self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), max_speed, 0
+        self.waiting_since = None
         handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
         self.handle = handle
         self._update_map()
@@ -76,6 +89,7 @@ class Navigator:
         """Stop following; the base brakes to rest."""
         self.follower.stop()
         self.goal = None
+        self.waiting_since = None
         if self.handle is not None:
             self.handle.fail("halted: braking")
             self.handle = None
@@ -92,13 +106,15 @@ class Navigator:
         now = self.robot.base.io.time
         if self.camera is not None and now - self.last_scan >= self.scan_period - 1e-9:
             self.last_scan = now
-            if self._update_map() and self.handle is not None and self._route_ahead_blocked():
-                self.replans += 1
-                if self.replans > MAX_REPLANS:
-                    self._finish_goal(f"the way stayed blocked after {MAX_REPLANS} replans", brake=True)
-                else:
-                    self._plan_and_follow()
+            self._update_map()
+            if self.waiting_since is not None or self._route_ahead_blocked():
+                self._replan(now)
+            self.follower.stop_at = self._blocked_at()
+            self._look_along_route()
         if self.handle is None:
+            return
+        if self.waiting_since is not None:
+            self.handle.feedback = f"waiting for the way to clear ({now - self.waiting_since:.0f} s)"
             return
         self.follower.step()
         motion = self.motion
@@ -109,18 +125,65 @@ class Navigator:
 
     # ------------------------------------------------------------------ internals
 
-    def _plan_and_follow(self) -> None:
-        start = self.robot.base.pose()
+    def _plan(self) -> Route:
         try:
-            route = plan_route(self.grid, start, self.goal, self.clearance)
-        except PlanError as error:
+            route = plan_route(self.grid, self.robot.base.pose(), self.goal, self.clearance)
+        except PlanError:
             self.planning_times.append(0.0)
-            self._finish_goal(str(error), brake=True)
-            return
+            raise
         self.planning_times.append(route.planning_time)
         self.route_lengths.append(route.length)
+        return route
+
+    def _plan_and_follow(self) -> None:
+        """The first plan of a goal: no route fails the goal at once (the map says the goal cannot be reached)."""
+        try:
+            route = self._plan()
+        except PlanError as error:
+            self._finish_goal(str(error), brake=True)
+            return
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
+
+    def _replan(self, now: float) -> None:
+        """The way ahead got blocked: take a new route, or stop and wait for one (a person may walk on)."""
+        self.replans += 1
+        try:
+            if self.replans > MAX_REPLANS:
+                raise PlanError(f"the way stayed blocked after {MAX_REPLANS} replans")
+            route = self._plan()
+        except PlanError as error:
+            if self.waiting_since is None:
+                self.waiting_since = now
+                self.motion = None
+                self.follower.stop()
+            elif now - self.waiting_since > WAIT_LIMIT or self.replans > MAX_REPLANS:
+                self._finish_goal(f"waited {WAIT_LIMIT:.0f} s for the way to clear: {error}", brake=True)
+            return
+        self.waiting_since = None
+        self.route = route
+        self.motion = self.follower.follow(route, self.max_speed)
+
+    def _look_along_route(self) -> None:
+        """Turn the head towards where the route goes next: the camera sees a bend (and who is there) early."""
+        route, pan = self.route, self.head_pan
+        if route is None or pan is None or self.follower.route is None:
+            return
+        s = self.follower.progress
+        point = route.points[min(np.searchsorted(route.arc_length, s + GAZE_AHEAD), len(route.points) - 1)]
+        x, y, yaw = self.robot.base.pose()
+        bearing = math.remainder(math.atan2(point[1] - y, point[0] - x) - yaw, 2 * math.pi)
+        self.robot.joints.move({pan: float(np.clip(bearing, -MAX_GAZE_PAN, MAX_GAZE_PAN))})
+
+    def _blocked_at(self) -> float | None:
+        """Arc length of the first point ahead on the route where the base would touch something, if any."""
+        route = self.route
+        if route is None or self.follower.route is None:
+            return None
+        s = self.follower.progress
+        ahead = (route.arc_length > s + 0.1) & (route.arc_length <= s + LOOKAHEAD)
+        blocked = ahead & (self.grid.clearance_at(route.points) < self.clearance.minimum)
+        return float(route.arc_length[np.argmax(blocked)]) if np.any(blocked) else None
 
     def _settle(self, motion: MotionHandle | None) -> None:
         if motion is not None and motion.status.name == "SUCCEEDED":
@@ -158,9 +221,22 @@ class Navigator:
         scan = self.camera.scan()
         base = self.robot.base.pose()[:2]
         hits = scan.hits
-        away = np.hypot(*(hits[:, :2] - base).T) > OWN_SPACE
-        solid = hits[away & (hits[:, 2] > OBSTACLE_MIN_HEIGHT) & (hits[:, 2] < ROBOT_HEIGHT)]
-        changed = self.grid.mark(solid[:, :2])
+        mine = np.hypot(*(hits[:, :2] - base).T) < self.robot.config.base.footprint_radius + OWN_MARGIN
+        whole_body = self.robot.whole_body
+        for side in self.robot.config.grippers:  # what a hand holds hangs below it: not an obstacle
+            hand = whole_body.frame_pose(whole_body.hand_frame(side)).translation
+            mine |= (np.hypot(*(hits[:, :2] - hand[:2]).T) < HELD_RADIUS) & (hits[:, 2] < hand[2] + 0.05)
+        keep = ~mine & (hits[:, 2] > OBSTACLE_MIN_HEIGHT) & (hits[:, 2] < ROBOT_HEIGHT)
+        rows, cols = self.grid.cell(hits[:, :2])
+        inside = self.grid.inside(rows, cols)
+        keep[inside] &= ~self._near_static[rows[inside], cols[inside]]  # the map already knows it
+        solid = hits[keep][:, :2]
+        # the camera sees only the near face of a thing: assume it is SEEN_DEPTH deep along the ray
+        away_from_camera = solid - scan.origin[:2]
+        away_from_camera /= np.maximum(np.hypot(*away_from_camera.T), 1e-6)[:, None]
+        depths = np.arange(0.0, SEEN_DEPTH + 1e-9, self.grid.resolution)
+        behind = solid[:, None, :] + depths[None, :, None] * away_from_camera[:, None, :]
+        changed = self.grid.mark(behind.reshape(-1, 2))
         rows, cols = self._cells_seen_free(scan)
         return self.grid.clear(rows, cols) or changed
 

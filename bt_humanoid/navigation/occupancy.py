@@ -17,13 +17,14 @@ import numpy as np
 class OccupancyGrid:
     """Static and observed occupancy over a rectangle of the floor, with a clearance field."""
 
-    def __init__(self, bounds: np.ndarray, resolution: float = 0.05) -> None:
+    def __init__(self, bounds: np.ndarray, resolution: float = 0.05, observed_padding: float = 0.0) -> None:
         self.origin = np.asarray(bounds[0], dtype=float)
         self.resolution = resolution
         size = np.ceil((np.asarray(bounds[1]) - self.origin) / resolution).astype(int)
         self.shape = (int(size[1]), int(size[0]))  # rows (y), cols (x)
         self.static = np.zeros(self.shape, dtype=bool)
         self.observed = np.zeros(self.shape, dtype=bool)
+        self.observed_padding = observed_padding  # m added around what the camera saw
         self._clearance: np.ndarray | None = None
 
     # ------------------------------------------------------------------ geometry
@@ -78,13 +79,24 @@ class OccupancyGrid:
 
     @property
     def clearance(self) -> np.ndarray:
-        """Metres from each cell centre to the nearest occupied cell (outside the grid counts as occupied)."""
+        """Metres from each cell centre to the nearest obstacle (outside the grid counts as one).
+
+        Observed obstacles count ``observed_padding`` bigger: the camera sees only their near side, and
+        what it saw may be a person who moves.
+        """
         if self._clearance is None:
-            free = np.pad(~self.occupied, 1, constant_values=False).astype(np.uint8)
-            distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
-            # distance to the nearest occupied cell's centre; its near edge is half a cell closer
-            self._clearance = np.maximum(distance - 0.5, 0.0) * self.resolution
+            static = self._distance(self.static, outside_occupied=True)
+            observed = self._distance(self.observed, outside_occupied=False) - self.observed_padding
+            self._clearance = np.maximum(np.minimum(static, observed), 0.0)
         return self._clearance
+
+    def _distance(self, occupied: np.ndarray, outside_occupied: bool) -> np.ndarray:
+        if not np.any(occupied) and not outside_occupied:
+            return np.full(self.shape, np.inf)
+        free = np.pad(~occupied, 1, constant_values=not outside_occupied).astype(np.uint8)
+        distance = cv2.distanceTransform(free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)[1:-1, 1:-1]
+        # distance to the nearest occupied cell's centre; its near edge is half a cell closer
+        return np.maximum(distance - 0.5, 0.0) * self.resolution
 
     def clearance_at(self, xy: np.ndarray) -> np.ndarray:
         """Clearance (m) at world points; 0 outside the grid."""

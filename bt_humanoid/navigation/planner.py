@@ -151,7 +151,7 @@ def _ompl_route(
         state = space.allocState()
         state.setX(float(pose[0]))
         state.setY(float(pose[1]))
-        state.setYaw(math.remainder(float(pose[2]), 2 * math.pi))  # SO(2) states live in [-π, π]
+        state.setYaw((float(pose[2]) + math.pi) % (2 * math.pi) - math.pi)  # SO(2) states live in [-π, π)
         states.append(state)
     setup.setStartAndGoalStates(states[0], states[1])
     if optimise:

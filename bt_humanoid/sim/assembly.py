@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from bt_humanoid.sim.robot_config import RobotConfig
-from bt_humanoid.sim.world_config import WorldConfig
+from bt_humanoid.sim.world_config import Walker, WorldConfig
 
 _EMPTY_PREFIX_WARNING = "Attaching a spec with an empty prefix"
 # MuJoCo repeats the Python warning at compile and save time, outside any context.
@@ -53,10 +53,44 @@ def robot_spec(config: RobotConfig) -> mujoco.MjSpec:
 def world_spec(world: WorldConfig, robot: RobotConfig) -> mujoco.MjSpec:
     """The scene with the robot attached at the world origin."""
     scene = mujoco.MjSpec.from_file(str(world.model_path))
+    for body, walker in world.walkers.items():
+        _add_walker(scene, body, walker)
     frame = scene.worldbody.add_frame()
     with _quiet_empty_prefix_warning():
         scene.attach(robot_spec(robot), frame=frame, prefix="")
     return scene
+
+
+WALKER_MASS = 60.0  # kg
+WALKER_HEIGHT = 1.7  # m
+
+
+def _add_walker(scene: mujoco.MjSpec, name: str, walker: Walker) -> None:
+    """A person on two slide joints (x, y) driven by velocity actuators: they move only by force."""
+    x, y = walker.route[0]
+    body = scene.worldbody.add_body(name=name, pos=[x, y, 0.0])
+    for axis, direction in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
+        joint = body.add_joint(name=f"{name}_{axis}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=direction, damping=50)
+        scene.add_actuator(
+            name=f"{name}_{axis}",
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            target=joint.name,
+            gaintype=mujoco.mjtGain.mjGAIN_FIXED,
+            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+            gainprm=[2000, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+            biasprm=[0, 0, -2000, 0, 0, 0, 0, 0, 0, 0],
+            forcelimited=True,
+            forcerange=[-400, 400],
+        )
+    r = walker.radius
+    body.add_geom(
+        name=f"{name}_body",
+        type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+        fromto=[0, 0, r + 0.02, 0, 0, WALKER_HEIGHT - r],
+        size=[r, 0, 0],
+        mass=WALKER_MASS,
+        rgba=[0.3, 0.45, 0.7, 1],
+    )
 
 
 def write_robot_mjcf(config: RobotConfig, path: Path) -> Path:

@@ -17,6 +17,7 @@ import numpy as np
 
 from bt_humanoid.sim.assembly import world_spec
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
+from bt_humanoid.sim.walkers import WalkerDriver
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 
 
@@ -30,6 +31,10 @@ class Simulation:
         self.model = self.spec.compile()
         self.data = mujoco.MjData(self.model)
         self.timestep = float(self.model.opt.timestep)
+        root = self.model.body(self.model.body_rootid[self.model.joint(robot.base.joints["x"]).bodyid[0]]).name
+        self.walkers = [
+            WalkerDriver(self.model, self.data, name, walker, root) for name, walker in world.walkers.items()
+        ]
         self.reset()
 
     @classmethod
@@ -61,6 +66,8 @@ class Simulation:
         self.data.qpos[self.model.joint(joint).qposadr[0]] = value
 
     def step(self, n: int = 1) -> None:
+        for walker in self.walkers:  # the scene's people act at the caller's rate (the control period)
+            walker.control()
         mujoco.mj_step(self.model, self.data, nstep=n)
 
     def actuator_for_joint(self, joint: str) -> int:

@@ -39,6 +39,14 @@ class Person(StrictModel):
     aliases: list[str] = Field(default_factory=list)
 
 
+class Walker(StrictModel):
+    """A person who walks a loop through the scene, on their own legs (actuators), pausing for the robot."""
+
+    route: list[tuple[float, float]] = Field(min_length=2, description="[x, y] corners of the loop (m)")
+    speed: float = Field(0.5, gt=0, le=2.0, description="walking speed (m/s)")
+    radius: float = Field(0.2, gt=0, le=0.5, description="body radius (m)")
+
+
 class WorldConfig(StrictModel):
     name: str
     description: str = ""
@@ -50,6 +58,7 @@ class WorldConfig(StrictModel):
     objects: dict[str, WorldObject] = Field(default_factory=dict)
     people: dict[str, Person] = Field(default_factory=dict)
     obstacles: list[str] = Field(default_factory=list)
+    walkers: dict[str, Walker] = Field(default_factory=dict)  # body name → how they walk
     folder: Path = Path()
 
     @property
@@ -63,5 +72,17 @@ class WorldConfig(StrictModel):
 
 
 def load_world_config(name: str) -> WorldConfig:
-    """Read worlds/<name>/world.yaml; unknown names get the list of valid ones."""
-    return read_config("world", worlds_dir(), name, "world.yaml", WorldConfig)  # type: ignore[return-value]
+    """Read worlds/<name>/world.yaml; unknown names get the list of valid ones.
+
+    A world may start from another (``extends: apartment``): it takes every
+    key of that world (its model file included) and overrides the ones it gives.
+    """
+    return read_config(  # type: ignore[return-value]
+        "world", worlds_dir(), name, "world.yaml", WorldConfig, inherit=_inherit_world
+    )
+
+
+def _inherit_world(parent: WorldConfig) -> dict:
+    inherited = parent.model_dump(exclude={"folder", "name", "description"})
+    inherited["model"] = str(parent.model_path)  # the parent's model file, wherever the child lives
+    return inherited
