@@ -40,6 +40,7 @@ class RouteFollower:
         self.route: Route | None = None
         self.handle: MotionHandle | None = None
         self.stop_at: float | None = None  # arc length where the route is blocked: stop short of it
+        self.speed_limit = math.inf  # m/s, set by the navigator near obstacles the camera saw
         self._otg = Ruckig(2, dt)
         self._input = InputParameter(2)
         self._output = OutputParameter(2)
@@ -69,6 +70,7 @@ class RouteFollower:
         self.route = route
         self.started_settling: float | None = None
         self.stop_at = None
+        self.speed_limit = math.inf
         self.handle = MotionHandle(f"following a {route.length:.1f} m route", on_cancel=lambda _: self.stop())
         return self.handle
 
@@ -118,7 +120,7 @@ class RouteFollower:
         if self.stop_at is not None:  # something ahead: slow so the base can stop short of it
             room = max(self.stop_at - STOP_SHORT - s, 0.0)
             cap = min(cap, math.sqrt(2 * limits.max_accel * room))
-        return max(min(cap, self.max_speed), 0.05)
+        return max(min(cap, self.max_speed, self.speed_limit), 0.05)
 
     def _heading_target(self, route: Route, s: float, index: int) -> float:
         if route.length - s < FINAL_STRETCH or route.length < 1e-6:

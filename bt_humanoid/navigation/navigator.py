@@ -35,6 +35,9 @@ HELD_RADIUS = 0.15  # m around a hand where points below it are what it holds
 SEEN_DEPTH = 0.3  # m an obstacle is assumed to extend behind the face the camera sees (a person, a parcel)
 OBSERVED_PADDING = 0.2  # m more room given to what the camera saw than to the furniture: it may move
 GAZE_AHEAD = 1.5  # m along the route where the head looks
+CAUTION_DISTANCE = 1.0  # m between the footprint and something the camera saw, below which the base slows
+CAUTION_SPEED = 0.5  # m/s allowed at CAUTION_DISTANCE, falling linearly to CREEP_SPEED
+CREEP_SPEED = 0.1  # m/s
 MAX_GAZE_PAN = 1.0  # rad the head turns from the heading at most
 LOOKAHEAD = 2.5  # m of route ahead checked against the map at every update
 MAX_REPLANS = 30  # per goal, before the goal fails as blocked
@@ -110,6 +113,7 @@ class Navigator:
             if self.waiting_since is not None or self._route_ahead_blocked():
                 self._replan(now)
             self.follower.stop_at = self._blocked_at()
+            self.follower.speed_limit = self._speed_near_obstacles()
             self._look_along_route()
         if self.handle is None:
             return
@@ -163,6 +167,14 @@ class Navigator:
         self.waiting_since = None
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
+
+    def _speed_near_obstacles(self) -> float:
+        """Slow down near what the camera saw: it may be a person who moves, or who has more to them than seen."""
+        here = self.robot.base.pose()[None, :2]
+        distance = float(self.grid.observed_distance_at(here)[0]) - self.robot.config.base.footprint_radius
+        if distance >= CAUTION_DISTANCE:
+            return math.inf
+        return max(CAUTION_SPEED * distance / CAUTION_DISTANCE, CREEP_SPEED)
 
     def _look_along_route(self) -> None:
         """Turn the head towards where the route goes next: the camera sees a bend (and who is there) early."""

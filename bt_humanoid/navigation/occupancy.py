@@ -26,6 +26,7 @@ class OccupancyGrid:
         self.observed = np.zeros(self.shape, dtype=bool)
         self.observed_padding = observed_padding  # m added around what the camera saw
         self._clearance: np.ndarray | None = None
+        self._observed_distance = np.full(self.shape, np.inf)
 
     # ------------------------------------------------------------------ geometry
 
@@ -86,9 +87,18 @@ class OccupancyGrid:
         """
         if self._clearance is None:
             static = self._distance(self.static, outside_occupied=True)
-            observed = self._distance(self.observed, outside_occupied=False) - self.observed_padding
-            self._clearance = np.maximum(np.minimum(static, observed), 0.0)
+            self._observed_distance = self._distance(self.observed, outside_occupied=False)
+            self._clearance = np.maximum(np.minimum(static, self._observed_distance - self.observed_padding), 0.0)
         return self._clearance
+
+    def observed_distance_at(self, xy: np.ndarray) -> np.ndarray:
+        """Metres from world points to the nearest obstacle the camera added (inf if none; 0 outside the grid)."""
+        self.clearance  # noqa: B018 - refreshes the fields
+        rows, cols = self.cell(xy)
+        inside = self.inside(rows, cols)
+        result = np.zeros(np.shape(rows))
+        result[inside] = self._observed_distance[rows[inside], cols[inside]]
+        return result
 
     def _distance(self, occupied: np.ndarray, outside_occupied: bool) -> np.ndarray:
         if not np.any(occupied) and not outside_occupied:

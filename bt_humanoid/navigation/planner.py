@@ -32,7 +32,8 @@ ou.RNG.setSeed(1)
 SAMPLE_SPACING = 0.05  # m between points of a planned route
 CORNER_RADIUS = 0.5  # m: the largest arc a corner is rounded with
 NEAR_ENDS = 0.5  # m around the start and goal where the smaller clearance applies
-OPTIMISE_TIME = 0.1  # s of wall time BIT* spends shortening a route (it stops early if the way is open)
+OPTIMISE_ITERATIONS = 3000  # BIT* iterations spent shortening a route (about 0.1 s here); a count, not a
+# duration, so a mission plans the same routes on any machine
 
 
 class PlanError(RuntimeError):
@@ -117,9 +118,9 @@ def plan_route(
         # BIT* (optimising path length) finds the short way round within a small budget; RRT-Connect is the
         # fallback that keeps looking (a goal it cannot reach in time_limit is walled off)
         state_valid = lambda state: valid_xy(state.getX(), state.getY())  # noqa: E731
-        solution = _ompl_route(grid, start, goal, state_valid, og.BITstar, OPTIMISE_TIME, optimise=True)
+        solution = _ompl_route(grid, start, goal, state_valid, og.BITstar, _iterations(OPTIMISE_ITERATIONS), True)
         if solution is None:
-            solution = _ompl_route(grid, start, goal, state_valid, og.RRTConnect, time_limit)
+            solution = _ompl_route(grid, start, goal, state_valid, og.RRTConnect, _seconds(time_limit))
         if solution is None:
             where = f"({goal[0]:.2f}, {goal[1]:.2f})"
             raise PlanError(f"no route to {where} within {time_limit:.1f} s of planning: it may be walled off")
@@ -130,10 +131,32 @@ def plan_route(
     return Route(points, arc, curvature, float(goal[2]), time.perf_counter() - started)
 
 
+def _iterations(count: int) -> ob.PlannerTerminationCondition:
+    """Stop after ``count`` planner iterations: the same work, so the same route, on any machine."""
+    done = [0]
+
+    def finished() -> bool:
+        done[0] += 1
+        return done[0] > count
+
+    return ob.PlannerTerminationCondition(finished)
+
+
+def _seconds(limit: float) -> ob.PlannerTerminationCondition:
+    deadline = time.perf_counter() + limit
+    return ob.PlannerTerminationCondition(lambda: time.perf_counter() > deadline)
+
+
 def _ompl_route(
-    grid: OccupancyGrid, start: np.ndarray, goal: np.ndarray, valid, planner, time_limit: float, optimise: bool = False
+    grid: OccupancyGrid,
+    start: np.ndarray,
+    goal: np.ndarray,
+    valid,
+    planner,
+    until: ob.PlannerTerminationCondition,
+    optimise: bool = False,
 ) -> np.ndarray | None:
-    """Corner points of an OMPL solution in SE(2), or None if there is none within ``time_limit`` s."""
+    """Corner points of an OMPL solution in SE(2), or None if there is none when ``until`` says stop."""
     space = ob.SE2StateSpace()
     bounds = ob.RealVectorBounds(2)
     high = grid.origin + np.array(grid.shape[::-1]) * grid.resolution
@@ -157,7 +180,7 @@ def _ompl_route(
     if optimise:
         setup.setOptimizationObjective(ob.PathLengthOptimizationObjective(information))
     setup.setPlanner(planner(information))
-    setup.solve(time_limit)
+    setup.solve(until)
     if not setup.haveExactSolutionPath():
         return None
     path = setup.getSolutionPath()  # every motion of it was checked; _shortcut simplifies it

@@ -32,6 +32,9 @@ def static_map(model: mujoco.MjModel, data: mujoco.MjData, bounds: np.ndarray, r
         if footprint is None:
             continue
         _fill(grid, footprint)
+    # the bounds are the walls' inner faces: the outermost cells are wall too
+    grid.static[[0, -1], :] = True
+    grid.static[:, [0, -1]] = True
     return grid
 
 
