@@ -172,3 +172,44 @@ def test_crossing_the_walking_persons_loop_never_touches_them():
     assert not [c for c in contacts if "walker" in c[1]]
     x, y, _ = scenario.truth.robot_pose()
     assert math.hypot(x - 7.0, y - 2.4) <= 0.05
+
+
+def test_the_small_moves_of_recovery_turn_back_up_and_spin():
+    mission = {
+        "mission": "small moves",
+        "tree": {
+            "sequence": [
+                {"turn": {"place": "kitchen"}},
+                {"name": "spin", "rotate_in_place": {"angle": 90}},
+                {"back_up": {"distance": 0.3}},
+                {"clear_map": {}},
+            ]
+        },
+    }
+    run = build_run(mission, robot_start=(3.0, -2.5, 0.0))
+    poses = []
+    run.executor.tick_listeners.append(lambda _: poses.append(run.truth.robot_pose()))
+    spin_started = []
+    run.events.listeners.append(
+        lambda e: (
+            spin_started.append(run.truth.robot_pose())
+            if e.get("node") == "sequence[1].rotate_in_place" and e["new"] == "RUNNING"
+            else None
+        )
+    )
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    facing_kitchen = math.atan2(2.4 + 2.5, 7.0 - 3.0)
+    assert abs(math.remainder(spin_started[0][2] - facing_kitchen, 2 * math.pi)) < math.radians(3)
+    x, y, yaw = scenario.truth.robot_pose()
+    assert abs(math.remainder(yaw - facing_kitchen - math.pi / 2, 2 * math.pi)) < math.radians(3)
+    assert math.hypot(x - 3.0, y + 2.5) == pytest.approx(0.3, abs=0.03)  # straight back from where it turned
+
+
+def test_back_up_refuses_when_the_map_shows_a_wall_behind():
+    run = build_run(
+        {"mission": "back into the wall", "tree": {"back_up": {"distance": 0.5}}}, robot_start=(0.0, -4.1, 90)
+    )
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "FAILURE"
+    assert "no room to back up 0.50 m" in scenario.result.cause

@@ -24,6 +24,7 @@ from bt_humanoid.strict_model import StrictModel, exactly_one
 
 LOOK_AHEAD_POSTURE = "look_ahead"  # robot.yaml posture: head level, camera on the way ahead
 OBJECT_STANDOFF = 0.35  # m between the footprint and an object on the floor
+STANCE_BACKOFF = 0.35  # m behind the stance for working on an object on a surface
 BACK_UP_SPEED = 0.2  # m/s
 
 
@@ -118,12 +119,13 @@ class NavigateTo(_BaseSkill):
         surface = belief.surface_under(obj.position) if obj.held_by is None else None
         if surface is not None:
             bounds = np.array(self.context.world.bounds)
+            radius = config.base.footprint_radius
             try:
-                return np.array(
-                    stance_for(obj.position[:2], surface, "right", config.base.footprint_radius, bounds, here[:2])
-                )
+                x, y, yaw = stance_for(obj.position[:2], surface, "right", radius, bounds, here[:2])
             except StanceError as error:
                 raise PhaseFailure(str(error)) from None
+            # a step back from the working stance: room to raise the arms before the last approach (stand_near)
+            return np.array([x - STANCE_BACKOFF * math.cos(yaw), y - STANCE_BACKOFF * math.sin(yaw), yaw])
         away = here[:2] - obj.position[:2]
         distance = config.base.footprint_radius + OBJECT_STANDOFF
         direction = away / max(float(np.hypot(*away)), 1e-6)
