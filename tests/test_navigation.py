@@ -213,3 +213,16 @@ def test_back_up_refuses_when_the_map_shows_a_wall_behind():
     scenario = Scenario(run, run.execute())
     assert scenario.result.tree_status == "FAILURE"
     assert "no room to back up 0.50 m" in scenario.result.cause
+
+
+def test_an_obstacle_the_camera_finds_gone_is_cleared_from_the_map():
+    run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
+    grid = run.navigator.grid
+    # a box the robot once saw on the way, no longer there: the cells are in the map, the floor is free
+    xs, ys = np.meshgrid(np.arange(1.8, 2.2, 0.05), np.arange(1.0, 1.4, 0.05))
+    phantom = np.stack([xs.ravel(), ys.ravel()], axis=1)
+    grid.mark(phantom)
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    still = grid.observed[grid.cell(phantom)]
+    assert still.mean() < 0.2, f"{still.sum()} of {still.size} cells still marked"
