@@ -11,6 +11,7 @@ import math
 import mujoco
 import numpy as np
 
+from bt_humanoid.sim.geometry import object_extents, rotation_of
 from bt_humanoid.sim.simulation import Simulation
 
 UPRIGHT_TOLERANCE_DEG = 15.0
@@ -34,6 +35,12 @@ class GroundTruth:
 
     def object_position(self, name: str) -> np.ndarray:
         return self.data.xpos[self._object_body(name)].copy()
+
+    def object_centre(self, name: str) -> np.ndarray:
+        """Centre of an object's bounding box (caps and handles included in height), world frame."""
+        body = self._object_body(name)
+        low, high = object_extents(self.model, body)
+        return self.data.xpos[body] + rotation_of(self.data.xquat[body]) @ ((low + high) / 2)
 
     def object_speed(self, name: str) -> float:
         body = self._object_body(name)

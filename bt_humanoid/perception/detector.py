@@ -1,0 +1,195 @@
+"""Find objects standing on support surfaces in an RGB-D frame, with their kind, colour, pose and size.
+
+Classical and explainable:
+
+1. every pixel becomes a world point (depth + camera pose);
+2. points over a known support surface and a little above it are object
+   candidates; depth jumps split touching things; connected regions of the
+   image are the objects;
+3. each region's points give its size and pose: the top few centimetres
+   outline its footprint (square: a box; round: a cylinder, a mug or a ball),
+   the highest point its height;
+4. shape decides the kind (a flat round top with a handle sticking out is a
+   mug, a tall round one a bottle, a rounded top a ball), the median colour
+   of its pixels its colour name.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from bt_humanoid.perception.rgbd_camera import RgbdFrame
+from bt_humanoid.perception.world_model import SupportSurface
+
+MIN_HEIGHT = 0.008  # m above a surface before a point can belong to an object
+MAX_HEIGHT = 0.45  # m above a surface: taller things are not objects on it
+EDGE_MARGIN = 0.01  # m inside a surface's edge (its rim is not an object)
+DEPTH_JUMP = 0.03  # m between neighbouring pixels that separates two things
+MIN_PIXELS = 25  # smaller regions are noise (or too far to judge)
+TOP_BAND = 0.03  # m below the highest point that outlines the footprint
+FLAT_BAND = 0.006  # m below the highest point that counts as a flat top
+RESTING = 0.03  # m: a region whose lowest point is higher above the surface is held, not resting
+MUG_PROPORTION = 1.4  # height / diameter below which a round thing without a visible handle is a mug
+
+
+@dataclass
+class Detection:
+    kind: str  # cube, box, bottle, can, mug, ball
+    colour: str
+    position: np.ndarray  # centre (world, m)
+    size: np.ndarray  # extents along the object's x, y and up (m)
+    yaw: float  # rad; a mug's handle points along its x
+    surface: str
+    pixels: int
+    visible_fraction: float  # of the footprint seen from above (occlusion), 0..1
+
+
+def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
+    """Objects resting on any of ``surfaces`` in the frame."""
+    points = frame.points()
+    candidate = np.zeros(frame.depth.shape, dtype=bool)
+    surface_of = np.full(frame.depth.shape, -1, dtype=int)
+    for index, surface in enumerate(surfaces):
+        (x0, y0), (x1, y1) = surface.region + np.array([[EDGE_MARGIN], [-EDGE_MARGIN]])
+        x, y, z = points[..., 0], points[..., 1], points[..., 2]
+        height = z - surface.height
+        over = (x > x0) & (x < x1) & (y > y0) & (y < y1) & (height > MIN_HEIGHT) & (height < MAX_HEIGHT)
+        surface_of[over & ~candidate] = index
+        candidate |= over
+    edges = _depth_edges(frame.depth)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats((candidate & ~edges).astype(np.uint8), connectivity=4)
+    labels = _reattach(labels, candidate & edges, frame.depth)
+    detections = []
+    for label in range(1, count):
+        if stats[label, cv2.CC_STAT_AREA] < MIN_PIXELS:
+            continue
+        rows, cols = np.nonzero(labels == label)
+        surface = surfaces[int(np.bincount(surface_of[rows, cols]).argmax())]
+        detection = _describe(points[rows, cols], frame.rgb[rows, cols], surface)
+        if detection is not None:
+            detections.append(detection)
+    return detections
+
+
+def _depth_edges(depth: np.ndarray) -> np.ndarray:
+    """Pixels next to a depth jump: boundaries between things that touch in the image."""
+    jump_rows = np.abs(np.diff(depth, axis=0)) > DEPTH_JUMP
+    jump_cols = np.abs(np.diff(depth, axis=1)) > DEPTH_JUMP
+    edges = np.zeros(depth.shape, dtype=bool)
+    edges[1:] |= jump_rows
+    edges[:, 1:] |= jump_cols
+    return edges
+
+
+def _reattach(labels: np.ndarray, loose: np.ndarray, depth: np.ndarray) -> np.ndarray:
+    """Give pixels cut off at depth jumps back to the neighbouring region at their own depth."""
+    labels = labels.copy()
+    for _ in range(2):
+        for dr, dc in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+            neighbour = np.roll(labels, (dr, dc), axis=(0, 1))
+            near = np.abs(np.roll(depth, (dr, dc), axis=(0, 1)) - depth) < DEPTH_JUMP
+            take = loose & (labels == 0) & (neighbour > 0) & near
+            labels[take] = neighbour[take]
+    return labels
+
+
+def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface) -> Detection | None:
+    heights = points[:, 2] - surface.height
+    if heights.min() > RESTING:
+        return None  # floating: something held above the surface
+    top = float(heights.max())
+    band = points[heights > top - TOP_BAND][:, :2]
+    flat = points[heights > top - FLAT_BAND][:, :2]
+    if len(band) < 5:
+        return None
+    (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
+    hull_area = cv2.contourArea(cv2.convexHull(band.astype(np.float32)))
+    rect_area = max(side_a * side_b, 1e-9)
+    squareness = hull_area / rect_area  # 1 for a box's top, π/4 for a disc
+    flatness = _area(flat) / max(hull_area, 1e-9)  # 1 for a flat top, small for a ball's cap
+    centre = np.array([cx, cy])
+    round_diameter = _circle(band)[1]
+    if squareness <= 0.9 and top > 2.0 * round_diameter:  # tall and round: a bottle (its cap is no flat top)
+        centre, diameter = _circle(band)
+        kind, size, yaw = "bottle", np.array([diameter, diameter, top]), 0.0
+    elif flatness < 0.35:
+        kind, centre, diameter = "ball", *_circle(band)
+        size = np.array([diameter, diameter, top])
+        yaw = 0.0
+    elif squareness > 0.9:
+        width, length = sorted((side_a, side_b))
+        kind = "cube" if length < 1.2 * width and abs(top - length) < 0.25 * length else "box"
+        size = np.array([length, width, top])
+        yaw = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
+    else:
+        body_centre, diameter, handle = _cylinder(band)
+        centre = body_centre
+        size = np.array([diameter, diameter, top])
+        yaw = 0.0
+        if handle is not None:
+            kind = "mug"
+            yaw = math.atan2(handle[1], handle[0])
+        else:  # the handle may be behind it: judge by proportions (a mug is about as tall as it is wide)
+            kind = "mug" if top < MUG_PROPORTION * diameter else "can"
+    position = np.array([centre[0], centre[1], surface.height + top / 2])
+    visible = min(1.0, hull_area / max(_footprint_area(kind, size), 1e-9))
+    return Detection(
+        kind, colour_name(np.median(colours, axis=0)), position, size, yaw, surface.name, len(points), visible
+    )
+
+
+def _area(xy: np.ndarray) -> float:
+    return float(cv2.contourArea(cv2.convexHull(xy.astype(np.float32)))) if len(xy) >= 3 else 0.0
+
+
+def _footprint_area(kind: str, size: np.ndarray) -> float:
+    return float(size[0] * size[1]) if kind in ("cube", "box") else math.pi * (size[0] / 2) ** 2
+
+
+def _circle(xy: np.ndarray) -> tuple[np.ndarray, float]:
+    (cx, cy), radius = cv2.minEnclosingCircle(xy.astype(np.float32))
+    return np.array([cx, cy]), 2.0 * radius
+
+
+def _cylinder(xy: np.ndarray) -> tuple[np.ndarray, float, np.ndarray | None]:
+    """Body centre and diameter of a round footprint, and the direction of a handle sticking out of it (if any)."""
+    centre, _ = _circle(xy)
+    offsets = xy - centre
+    distance = np.hypot(*offsets.T)
+    # the body: points within the bulk of the distances; a handle is a lump further out on one side
+    body = distance <= np.percentile(distance, 80)
+    body_centre, body_diameter = _circle(xy[body])
+    offsets = xy - body_centre
+    distance = np.hypot(*offsets.T)
+    outside = distance > body_diameter / 2 + 0.008
+    if outside.sum() >= max(3, 0.04 * len(xy)):
+        direction = offsets[outside].mean(axis=0)
+        return body_centre, body_diameter, direction / max(float(np.hypot(*direction)), 1e-9)
+    return body_centre, body_diameter, None
+
+
+COLOUR_HUES = [  # OpenCV hue (0..180) upper bounds
+    (8, "red"),
+    (20, "orange"),
+    (34, "yellow"),
+    (85, "green"),
+    (130, "blue"),
+    (155, "purple"),
+    (170, "pink"),
+    (180, "red"),
+]
+
+
+def colour_name(rgb: np.ndarray) -> str:
+    """The everyday name of a colour: hue decides, unless it is too pale or too dark to have one."""
+    pixel = np.clip(np.asarray(rgb, dtype=float), 0, 255).astype(np.uint8).reshape(1, 1, 3)
+    hue, saturation, value = (int(v) for v in cv2.cvtColor(pixel, cv2.COLOR_RGB2HSV)[0, 0])
+    if value < 50:
+        return "black"
+    if saturation < 45:
+        return "white" if value > 170 else "grey"
+    return next(name for bound, name in COLOUR_HUES if hue < bound)
