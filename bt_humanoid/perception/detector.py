@@ -34,6 +34,8 @@ TOP_BAND = 0.03  # m below the highest point that outlines the footprint
 FLAT_BAND = 0.006  # m below the highest point that counts as a flat top
 RESTING = 0.03  # m: a region whose lowest point is higher above the surface is held, not resting
 MUG_PROPORTION = 1.4  # height / diameter below which a round thing without a visible handle is a mug
+SQUARE = 0.88  # share of its bounding rectangle a flat top fills, above which it is a box's (a disc fills π/4)
+TALL = 2.0  # height / width above which a thing is a bottle
 
 
 @dataclass
@@ -107,20 +109,18 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface) 
     if len(band) < 5:
         return None
     (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
-    hull_area = cv2.contourArea(cv2.convexHull(band.astype(np.float32)))
-    rect_area = max(side_a * side_b, 1e-9)
-    squareness = hull_area / rect_area  # 1 for a box's top, π/4 for a disc
+    hull_area = _area(band)
+    narrow = min(side_a, side_b)
     flatness = _area(flat) / max(hull_area, 1e-9)  # 1 for a flat top, small for a ball's cap
     centre = np.array([cx, cy])
-    round_diameter = _circle(band)[1]
-    if squareness <= 0.9 and top > 2.0 * round_diameter:  # tall and round: a bottle (its cap is no flat top)
+    if top > TALL * narrow:  # tall and narrow: a bottle (its cap is no flat top)
         centre, diameter = _circle(band)
         kind, size, yaw = "bottle", np.array([diameter, diameter, top]), 0.0
     elif flatness < 0.35:
         kind, centre, diameter = "ball", *_circle(band)
         size = np.array([diameter, diameter, top])
         yaw = 0.0
-    elif squareness > 0.9:
+    elif _fill(flat) > SQUARE:  # the flat top fills its bounding rectangle: a box's lid, not a disc
         width, length = sorted((side_a, side_b))
         kind = "cube" if length < 1.2 * width and abs(top - length) < 0.25 * length else "box"
         size = np.array([length, width, top])
@@ -140,6 +140,14 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface) 
     return Detection(
         kind, colour_name(np.median(colours, axis=0)), position, size, yaw, surface.name, len(points), visible
     )
+
+
+def _fill(xy: np.ndarray) -> float:
+    """How much of its smallest bounding rectangle a point set's outline covers: 1 a rectangle, π/4 a disc."""
+    if len(xy) < 3:
+        return 0.0
+    (_, _), (a, b), _ = cv2.minAreaRect(xy.astype(np.float32))
+    return _area(xy) / max(a * b, 1e-9)
 
 
 def _area(xy: np.ndarray) -> float:
