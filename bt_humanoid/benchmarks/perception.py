@@ -4,7 +4,7 @@
 
 Each scene puts one to four of the apartment's objects at random spots and
 yaws on the dining table (the rest wait on the counter), paints each one a
-random colour, scales and turns the light, and stands the robot 0.9 to 1.5 m
+random colour, scales and turns the light, and stands the robot 0.7 to 1.3 m
 from a random side of the table, looking at it. Objects hide one another
 partly. One frame is rendered and the detector runs on it.
 
@@ -71,7 +71,7 @@ def build_scene(rng: np.random.Generator):
     chosen = list(rng.choice(names, size=int(rng.integers(1, 5)), replace=False))
     (x0, y0), (x1, y1) = table.region
     side = int(rng.integers(3))  # west, south, east: the chair blocks the north
-    distance = rng.uniform(0.9, 1.5)
+    distance = rng.uniform(0.7, 1.3)
     along = rng.uniform(-0.3, 0.3)
     centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
     if side == 0:

@@ -29,13 +29,17 @@ MIN_HEIGHT = 0.008  # m above a surface before a point can belong to an object
 MAX_HEIGHT = 0.45  # m above a surface: taller things are not objects on it
 EDGE_MARGIN = 0.01  # m inside a surface's edge (its rim is not an object)
 DEPTH_JUMP = 0.03  # m between neighbouring pixels that separates two things
-MIN_PIXELS = 25  # smaller regions are noise (or too far to judge)
+MIN_PIXELS = 10  # smaller regions are noise (or too far to judge)
+MIN_WIDTH = 0.025  # m across the line of sight: narrower regions are slivers of something
 TOP_BAND = 0.03  # m below the highest point that outlines the footprint
 FLAT_BAND = 0.006  # m below the highest point that counts as a flat top
 RESTING = 0.03  # m: a region whose lowest point is higher above the surface is held, not resting
 MUG_PROPORTION = 1.4  # height / diameter below which a round thing without a visible handle is a mug
-SQUARE = 0.88  # share of its bounding rectangle a flat top fills, above which it is a box's (a disc fills π/4)
+SQUARE = 0.87  # share of its bounding rectangle a flat top fills, above which it is a box's (a disc fills π/4)
 TALL = 2.0  # height / width above which a thing is a bottle
+BALL_TAPER = 0.8  # a ball is much narrower near its top than at its middle...
+BALL_FLATNESS = 0.17  # ...and has little flat top
+BOX_FLATNESS = 0.3  # share of a thing's visible points on its flat top above which it is a box (a lid faces up)
 
 
 @dataclass
@@ -71,10 +75,20 @@ def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
             continue
         rows, cols = np.nonzero(labels == label)
         surface = surfaces[int(np.bincount(surface_of[rows, cols]).argmax())]
-        detection = _describe(points[rows, cols], frame.rgb[rows, cols], surface)
+        detection = _describe(points[rows, cols], frame.rgb[rows, cols], surface, frame.position)
         if detection is not None:
             detections.append(detection)
-    return detections
+    return _without_fragments(detections)
+
+
+def _without_fragments(detections: list[Detection]) -> list[Detection]:
+    """Drop a region that lies within a bigger one's footprint: a part of it cut off by a depth jump."""
+    kept: list[Detection] = []
+    for detection in sorted(detections, key=lambda d: -d.pixels):
+        inside = any(np.hypot(*(detection.position[:2] - k.position[:2])) < max(k.size[:2]) / 2 + 0.01 for k in kept)
+        if not inside:
+            kept.append(detection)
+    return kept
 
 
 def _depth_edges(depth: np.ndarray) -> np.ndarray:
@@ -99,47 +113,64 @@ def _reattach(labels: np.ndarray, loose: np.ndarray, depth: np.ndarray) -> np.nd
     return labels
 
 
-def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface) -> Detection | None:
+def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, eye: np.ndarray) -> Detection | None:
     heights = points[:, 2] - surface.height
     if heights.min() > RESTING:
         return None  # floating: something held above the surface
     top = float(heights.max())
     band = points[heights > top - TOP_BAND][:, :2]
-    flat = points[heights > top - FLAT_BAND][:, :2]
+    flat_top = points[heights > top - FLAT_BAND][:, :2]
     if len(band) < 5:
         return None
-    (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
-    hull_area = _area(band)
-    narrow = min(side_a, side_b)
-    flatness = _area(flat) / max(hull_area, 1e-9)  # 1 for a flat top, small for a ball's cap
-    centre = np.array([cx, cy])
-    if top > TALL * narrow:  # tall and narrow: a bottle (its cap is no flat top)
+    # shape cues that one oblique view gives reliably: the silhouette's width across the line of sight (at the
+    # middle and near the top), how much of the object is its flat top, and how full that top's outline is
+    across = _across(points[:, :2], eye)
+    width = _extent(points[:, :2], across)
+    middle = _extent(points[(heights > 0.3 * top) & (heights < 0.7 * top)][:, :2], across)
+    near_top = _extent(points[heights > 0.85 * top][:, :2], across)
+    flatness = float(np.mean(heights > top - FLAT_BAND))
+    tapering = near_top / max(middle, 1e-6)
+    centre, diameter, handle = _cylinder(band)
+    if width < MIN_WIDTH:
+        return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
+    if top > TALL * width:
+        kind = "bottle"
+    elif handle is not None:
+        kind = "mug"
+    elif tapering < BALL_TAPER and flatness < BALL_FLATNESS:
+        kind = "ball"
         centre, diameter = _circle(band)
-        kind, size, yaw = "bottle", np.array([diameter, diameter, top]), 0.0
-    elif flatness < 0.35:
-        kind, centre, diameter = "ball", *_circle(band)
-        size = np.array([diameter, diameter, top])
-        yaw = 0.0
-    elif _fill(flat) > SQUARE:  # the flat top fills its bounding rectangle: a box's lid, not a disc
-        width, length = sorted((side_a, side_b))
-        kind = "cube" if length < 1.2 * width and abs(top - length) < 0.25 * length else "box"
-        size = np.array([length, width, top])
+    elif flatness >= BOX_FLATNESS or (top < 0.8 * width and flatness >= 0.22) or _fill(flat_top) > SQUARE:
+        kind = "box"
+    else:
+        kind = "mug" if top < MUG_PROPORTION * diameter else "can"
+    if kind == "box":
+        (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
+        narrow, long = sorted((side_a, side_b))
+        kind = "cube" if long < 1.25 * narrow and abs(top - long) < 0.3 * long else "box"
+        centre, size = np.array([cx, cy]), np.array([long, narrow, top])
         yaw = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
     else:
-        body_centre, diameter, handle = _cylinder(band)
-        centre = body_centre
         size = np.array([diameter, diameter, top])
-        yaw = 0.0
-        if handle is not None:
-            kind = "mug"
-            yaw = math.atan2(handle[1], handle[0])
-        else:  # the handle may be behind it: judge by proportions (a mug is about as tall as it is wide)
-            kind = "mug" if top < MUG_PROPORTION * diameter else "can"
+        yaw = math.atan2(handle[1], handle[0]) if handle is not None else 0.0
     position = np.array([centre[0], centre[1], surface.height + top / 2])
-    visible = min(1.0, hull_area / max(_footprint_area(kind, size), 1e-9))
-    return Detection(
-        kind, colour_name(np.median(colours, axis=0)), position, size, yaw, surface.name, len(points), visible
-    )
+    visible = min(1.0, _area(band) / max(_footprint_area(kind, size), 1e-9))
+    colour = colour_name(np.median(colours, axis=0))
+    return Detection(kind, colour, position, size, yaw, surface.name, len(points), visible)
+
+
+def _across(xy: np.ndarray, eye: np.ndarray) -> np.ndarray:
+    """Unit vector on the floor across the line of sight from the camera to these points."""
+    sight = xy.mean(axis=0) - eye[:2]
+    sight /= max(float(np.hypot(*sight)), 1e-9)
+    return np.array([-sight[1], sight[0]])
+
+
+def _extent(xy: np.ndarray, direction: np.ndarray) -> float:
+    if len(xy) < 2:
+        return 0.0
+    projected = xy @ direction
+    return float(projected.max() - projected.min())
 
 
 def _fill(xy: np.ndarray) -> float:
