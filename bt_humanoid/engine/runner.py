@@ -19,6 +19,8 @@ from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.mission.success import ConditionResult, check_condition
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.declared import declared_world_model
+from bt_humanoid.perception.perceiver import Perceiver
+from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.simulation import Simulation
@@ -100,9 +102,14 @@ class MissionRun:
             max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),
             blackboard=Blackboard(header.blackboard),
             speak=say,
-            world_model=declared_world_model(world, self.sim.model),
+            world_model=self._initial_world_model(),
             navigator=self.navigator,
         )
+        self.perceiver: Perceiver | None = None
+        if header.perception == "camera":
+            camera = next(iter(robot_config.cameras))
+            self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, "base")
+            self.robot.planners.append(self.perceiver)
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget
         margin = safety.joint_limit_margin if safety.joint_limit_margin is not None else defaults.joint_limit_margin
@@ -118,6 +125,14 @@ class MissionRun:
 
         self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_retry).compile(self.spec)
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
+
+    def _initial_world_model(self) -> WorldModel:
+        """What the robot knows at the start: the objects the world declares, or (with the camera) none yet."""
+        known = self.spec.known
+        belief = declared_world_model(known.world, self.sim.model)
+        if self.spec.header.perception == "camera":
+            belief.objects.clear()  # surfaces and people are map knowledge; objects must be seen
+        return belief
 
     def request_stop(self, reason: str = "stop requested") -> None:
         self.stop_monitor.request(reason)

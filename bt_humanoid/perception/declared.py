@@ -31,6 +31,7 @@ def declared_world_model(world: WorldConfig, model: mujoco.MjModel) -> WorldMode
     for name, person in world.people.items():
         for alias in (name, *person.aliases):
             belief.people[alias] = model.body(person.body).pos.copy()
+    belief.vocabulary = {name: (declared.kind, declared.colour) for name, declared in world.objects.items()}
     for name, declared in world.objects.items():
         body = model.body(declared.body)
         w, _, _, z = body.quat

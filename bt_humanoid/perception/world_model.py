@@ -9,6 +9,7 @@ put down is where it let go.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,6 +33,7 @@ class TrackedObject:
     keep_upright: bool = False
     held_by: str | None = None  # gripper side while the robot holds it
     grip_offset: float = 0.0  # m the grip site sits above the centre, while held
+    votes: Counter = field(default_factory=Counter)  # (kind, colour) → sightings, when perception tracks it
 
     @property
     def bottom(self) -> float:
@@ -59,15 +61,29 @@ class WorldModel:
     objects: dict[str, TrackedObject] = field(default_factory=dict)
     surfaces: dict[str, SupportSurface] = field(default_factory=dict)
     people: dict[str, np.ndarray] = field(default_factory=dict)  # name or alias → position (m)
+    vocabulary: dict[str, tuple[str, str]] = field(default_factory=dict)  # what people call things → (kind, colour)
 
     def object(self, name: str) -> TrackedObject:
-        """An object by id or by name; a clear error listing what is known otherwise."""
+        """An object by id, by name, or by what people call it (the vocabulary: "water bottle" is a blue bottle).
+
+        Objects believed gone (confidence 0) are only found by id.
+        """
         if name in self.objects:
             return self.objects[name]
-        for tracked in self.objects.values():
-            if tracked.name == name:
-                return tracked
-        known = [o.name for o in self.objects.values()]
+        present = [o for o in self.objects.values() if o.confidence > 0.0 or o.held_by is not None]
+        named = [o for o in present if o.name == name]
+        if not named and name in self.vocabulary:
+            kind, colour = self.vocabulary[name]
+            named = [o for o in present if o.kind == kind and o.colour == colour]
+        if named:
+            return max(named, key=lambda o: (o.held_by is not None, o.confidence, o.last_seen))
+        if any(o.name == name for o in self.objects.values()):
+            raise KeyError(f"I do not know where the {name} is now")  # believed gone: slipped, taken away
+        if name in self.vocabulary:
+            kind, colour = self.vocabulary[name]
+            what = "" if name == f"{colour} {kind}" else f" (a {colour} {kind})"
+            raise KeyError(f"I have not seen the {name}{what} yet")
+        known = [o.name for o in present]
         raise KeyError(f"no object {name!r} in the world model; {did_you_mean(name, known)}")
 
     def surface(self, name: str) -> SupportSurface:

@@ -1,0 +1,99 @@
+"""Fuse detections from camera frames into the WorldModel's tracked objects.
+
+A detection joins the tracked object it lies closest to (same surface,
+within a few centimetres), moving its estimate towards the new one and
+adding a vote for its kind and colour: one view may take a mug with its
+handle hidden for a can, the next view sees the handle, and the votes
+settle it. A detection near no tracked object starts a new one. A tracked
+object that should be in view (inside the image, in range, nothing nearer
+in front of it) but is not seen loses confidence; at zero it is gone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bt_humanoid.perception.detector import Detection
+from bt_humanoid.perception.rgbd_camera import RgbdFrame
+from bt_humanoid.perception.world_model import TrackedObject, WorldModel
+
+ASSOCIATE = 0.06  # m: a detection this close to a tracked object's centre is that object
+NEW_WEIGHT = 0.5  # share of a new detection in a tracked object's updated position
+GAIN = 0.35  # confidence gained per sighting
+LOSS = 0.5  # factor on confidence per frame an object should have been seen and was not
+GONE = 0.15  # below this confidence an object is no longer believed to be there
+SIGHT_RANGE = 3.0  # m: farther objects are not expected to be detected
+
+
+def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame) -> None:
+    """Update ``belief`` with one frame's detections."""
+    seen: set[str] = set()
+    for detection in detections:
+        tracked = _nearest(belief, detection)
+        if tracked is None:
+            tracked = _new(belief, detection, frame.time)
+        else:
+            _update(tracked, detection, frame.time)
+        seen.add(tracked.id)
+    for tracked in belief.objects.values():
+        if tracked.id in seen or tracked.held_by is not None or tracked.confidence <= 0.0:
+            continue
+        if _should_be_visible(tracked, frame):
+            tracked.confidence *= LOSS
+            if tracked.confidence < GONE:
+                tracked.confidence = 0.0
+
+
+def _nearest(belief: WorldModel, detection: Detection) -> TrackedObject | None:
+    candidates = [
+        o
+        for o in belief.objects.values()
+        if o.held_by is None and np.linalg.norm(o.position - detection.position) < ASSOCIATE
+    ]
+    return min(candidates, key=lambda o: np.linalg.norm(o.position - detection.position)) if candidates else None
+
+
+def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject:
+    number = 1 + sum(1 for o in belief.objects.values() if o.id.startswith(f"{detection.kind}-"))
+    tracked = TrackedObject(
+        id=f"{detection.kind}-{number}",
+        name=f"{detection.colour} {detection.kind}",
+        kind=detection.kind,
+        colour=detection.colour,
+        position=detection.position.copy(),
+        yaw=detection.yaw,
+        size=detection.size.copy(),
+        confidence=GAIN,
+        last_seen=time,
+        keep_upright=detection.kind in ("bottle", "mug", "can"),
+    )
+    tracked.votes[(detection.kind, detection.colour)] += 1
+    belief.update(tracked)
+    return tracked
+
+
+def _update(tracked: TrackedObject, detection: Detection, time: float) -> None:
+    tracked.position = (1 - NEW_WEIGHT) * tracked.position + NEW_WEIGHT * detection.position
+    tracked.size = (1 - NEW_WEIGHT) * tracked.size + NEW_WEIGHT * detection.size
+    tracked.confidence = min(1.0, tracked.confidence + GAIN)
+    tracked.last_seen = time
+    tracked.votes[(detection.kind, detection.colour)] += 1
+    (kind, colour), _ = tracked.votes.most_common(1)[0]
+    if detection.kind == "mug" or kind != "mug":
+        tracked.yaw = detection.yaw  # only a view that saw the handle knows a mug's yaw
+    tracked.kind, tracked.colour = kind, colour
+    tracked.name = f"{colour} {kind}"
+    tracked.keep_upright = kind in ("bottle", "mug", "can")
+
+
+def _should_be_visible(tracked: TrackedObject, frame: RgbdFrame) -> bool:
+    local = frame.rotation.T @ (tracked.position - frame.position)
+    distance = -local[2]
+    if distance <= 0.1 or distance > SIGHT_RANGE:
+        return False
+    col = int(frame.centre[0] + frame.focal * local[0] / distance)
+    row = int(frame.centre[1] - frame.focal * local[1] / distance)
+    height, width = frame.depth.shape
+    if not (0 <= row < height and 0 <= col < width):
+        return False
+    return bool(frame.depth[row, col] > distance - 0.05)  # nothing nearer in front of it
