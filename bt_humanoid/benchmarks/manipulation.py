@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from bt_humanoid.control.stance import MAX_DEPTH, stance_for
+from bt_humanoid.perception.declared import declared_world_model
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
@@ -105,12 +106,13 @@ def sample_trial(kind: str, surface: SupportSurface, bounds: np.ndarray, footpri
         )
 
 
-def run_trial(trial: Trial) -> Outcome:
+def run_trial(trial: Trial, perception: str = "declared") -> Outcome:
     name = OBJECTS[trial.kind]
     mission = {
         "mission": f"benchmark: pick and place the {name}",
         "world": "apartment",
         "robot": "wheeled_humanoid",
+        "perception": perception,
         "tree": {
             "sequence": [
                 {"pick": {"object": name, "side": SIDE}},
@@ -120,7 +122,7 @@ def run_trial(trial: Trial) -> Outcome:
     }
     run = build_run(mission, robot_start=trial.start)
     parking = iter(PARKING)
-    belief = run.context.world_model
+    belief = declared_world_model(run.context.world, run.sim.model)  # set-up: where the world file puts things
     for other in list(run.context.world.objects):
         surface = belief.surface_under(belief.object(other).position)
         if other != name and surface is not None and surface.name == SURFACE:
@@ -188,6 +190,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--trials", type=int, default=50, help="trials per kind (default 50)")
     parser.add_argument("--kinds", nargs="+", choices=list(OBJECTS), default=list(OBJECTS), help="object kinds")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the scenes (default 0)")
+    parser.add_argument(
+        "--perception",
+        choices=["declared", "camera"],
+        default="declared",
+        help="objects known from the world file, or only once the head camera has seen them",
+    )
     parser.add_argument("--json", type=Path, help="also write the figures here")
     args = parser.parse_args(argv)
     if args.trials < 1:
@@ -199,14 +207,17 @@ def main(argv: list[str] | None = None) -> int:
     surface = probe.context.world_model.surface(SURFACE)
     bounds = np.array(probe.context.world.bounds)
     footprint = probe.context.robot_config.base.footprint_radius
-    print(f"bt-humanoid manipulation benchmark: {args.trials} trials per kind, seed {args.seed} (one core)")
+    print(
+        f"bt-humanoid manipulation benchmark: {args.trials} trials per kind, seed {args.seed}, "
+        f"perception {args.perception} (one core)"
+    )
     started = time.perf_counter()
     summaries, qp_times = [], []
     for kind in args.kinds:
         trials = [sample_trial(kind, surface, bounds, footprint, rng) for _ in range(args.trials)]
         outcomes = []
         for i, trial in enumerate(trials, 1):
-            outcome = run_trial(trial)
+            outcome = run_trial(trial, args.perception)
             outcomes.append(outcome)
             qp_times.extend(outcome.qp_times)
             verdict = "ok" if outcome.placed else f"FAILED: {outcome.failure}"

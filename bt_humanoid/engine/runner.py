@@ -102,7 +102,7 @@ class MissionRun:
             max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),
             blackboard=Blackboard(header.blackboard),
             speak=say,
-            world_model=self._initial_world_model(),
+            world_model=self.initial_world_model(),
             navigator=self.navigator,
         )
         self.perceiver: Perceiver | None = None
@@ -110,6 +110,7 @@ class MissionRun:
             camera = next(iter(robot_config.cameras))
             self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, "base")
             self.robot.planners.append(self.perceiver)
+            self.context.perceiver = self.perceiver
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget
         margin = safety.joint_limit_margin if safety.joint_limit_margin is not None else defaults.joint_limit_margin
@@ -126,7 +127,7 @@ class MissionRun:
         self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_retry).compile(self.spec)
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
 
-    def _initial_world_model(self) -> WorldModel:
+    def initial_world_model(self) -> WorldModel:
         """What the robot knows at the start: the objects the world declares, or (with the camera) none yet."""
         known = self.spec.known
         belief = declared_world_model(known.world, self.sim.model)

@@ -40,6 +40,7 @@ TALL = 2.0  # height / width above which a thing is a bottle
 BALL_TAPER = 0.8  # a ball is much narrower near its top than at its middle...
 BALL_FLATNESS = 0.17  # ...and has little flat top
 BOX_FLATNESS = 0.3  # share of a thing's visible points on its flat top above which it is a box (a lid faces up)
+WELL_SEEN_TOP = 40  # points on a flat top from which its outline tells a square from a disc
 
 
 @dataclass
@@ -140,7 +141,7 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     elif tapering < BALL_TAPER and flatness < BALL_FLATNESS:
         kind = "ball"
         centre, diameter = _circle(band)
-    elif flatness >= BOX_FLATNESS or (top < 0.8 * width and flatness >= 0.22) or _fill(flat_top) > SQUARE:
+    elif _boxy(flat_top, flatness, top, width):
         kind = "box"
     else:
         kind = "mug" if top < MUG_PROPORTION * diameter else "can"
@@ -151,12 +152,21 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
         centre, size = np.array([cx, cy]), np.array([long, narrow, top])
         yaw = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
     else:
+        if kind in ("mug", "can") and len(flat_top) >= WELL_SEEN_TOP:
+            centre, diameter = _circle(flat_top)  # the rim: the body alone (a mug's handle is lower)
         size = np.array([diameter, diameter, top])
         yaw = math.atan2(handle[1], handle[0]) if handle is not None else 0.0
     position = np.array([centre[0], centre[1], surface.height + top / 2])
     visible = min(1.0, _area(band) / max(_footprint_area(kind, size), 1e-9))
     colour = colour_name(np.median(colours, axis=0))
     return Detection(kind, colour, position, size, yaw, surface.name, len(points), visible)
+
+
+def _boxy(flat_top: np.ndarray, flatness: float, top: float, width: float) -> bool:
+    """A box's lid rather than a cylinder's disc: by the lid's outline when it is seen well, else by proportions."""
+    if len(flat_top) >= WELL_SEEN_TOP:
+        return _fill(flat_top) > SQUARE
+    return flatness >= BOX_FLATNESS or (top < 0.8 * width and flatness >= 0.22) or _fill(flat_top) > SQUARE
 
 
 def _across(xy: np.ndarray, eye: np.ndarray) -> np.ndarray:

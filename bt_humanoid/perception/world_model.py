@@ -56,6 +56,10 @@ class SupportSurface:
         return bool(np.all(xy >= self.region[0] + margin) and np.all(xy <= self.region[1] - margin))
 
 
+# kinds one view can confuse (a handle hidden behind a mug, a cube's top seen at a grazing angle)
+LOOK_ALIKES = {"can": ("mug",), "mug": ("can", "cube"), "cube": ("box", "mug"), "box": ("cube",)}
+
+
 @dataclass
 class WorldModel:
     objects: dict[str, TrackedObject] = field(default_factory=dict)
@@ -75,6 +79,8 @@ class WorldModel:
         if not named and name in self.vocabulary:
             kind, colour = self.vocabulary[name]
             named = [o for o in present if o.kind == kind and o.colour == colour]
+            if not named:  # one view may take a mug for a can, or a cube for a box: the right colour and a look-alike
+                named = [o for o in present if o.colour == colour and kind in LOOK_ALIKES.get(o.kind, ())]
         if named:
             return max(named, key=lambda o: (o.held_by is not None, o.confidence, o.last_seen))
         if any(o.name == name for o in self.objects.values()):

@@ -8,6 +8,7 @@ from typing import Any
 
 from bt_humanoid.control.robot import RobotController
 from bt_humanoid.navigation.navigator import Navigator
+from bt_humanoid.perception.perceiver import Perceiver
 from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.world_config import WorldConfig
@@ -53,3 +54,4 @@ class SkillContext(CheckContext):
     speak: Callable[[str], None] = print
     world_model: WorldModel = field(default_factory=WorldModel)  # what the robot believes; skills read only this
     navigator: Navigator | None = None  # plans and follows routes for the base
+    perceiver: Perceiver | None = None  # fills the world model from the head camera (missions with perception: camera)

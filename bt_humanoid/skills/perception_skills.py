@@ -1,10 +1,9 @@
 """Skills that locate things: find.
 
 ``find`` asks the WorldModel where an object is believed to be and turns the
-head camera onto it. It fails when the belief is gone (the object slipped
-away or was never known), so recovery can react. The RGB-D pipeline of the
-perception issue will confirm the object in the image and search when the
-belief is stale; callers and behaviours stay the same.
+head camera onto it. When the robot has a camera in the loop and does not
+know the object yet, it looks ahead, left and right first. It fails with the
+reason when it still does not know (searching other rooms comes next).
 """
 
 from __future__ import annotations
@@ -19,12 +18,14 @@ from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel
 
+LOOK_AROUND = (0.0, 1.0, -1.0)  # head pan (rad) of each look when the object is not known yet
+
 
 class FindParams(StrictModel):
     object: str = Field(description="the object to find (from the world model)")
 
 
-@skill("find", "locate an object: recall where it is believed to be and look at it")
+@skill("find", "locate an object: recall where it is believed to be, or look around for it, and look at it")
 class Find(_ManipulationSkill):
     Params = FindParams
 
@@ -33,18 +34,41 @@ class Find(_ManipulationSkill):
         return check_name(params.object, context.world.objects, "object", "object")
 
     def phases(self):
-        return [("recall", self._recall), ("look", self._look)]
+        phases = [("recall", self._recall)]
+        for angle in LOOK_AROUND:  # not known yet: look left, ahead and right with the head camera
+            phases += [("look around", lambda a=angle: self._turn_head(a)), ("look around", self._look)]
+        return [*phases, ("look at it", self._look_at_it)]
 
     def _recall(self) -> None:
-        self.target = self._object(self.params.object)
-        if self.target.held_by is not None:
-            return
-        if self.target.confidence <= 0.0:
-            raise PhaseFailure(f"I do not know where the {self.target.name} is now")
-        if self.context.world_model.surface_under(self.target.position) is None:
-            raise PhaseFailure(f"the {self.target.name} is not on any surface I know")
+        self.target = self._known()
+        if self.target is None and self.context.perceiver is None:
+            self.target = self._object(self.params.object)  # raises with the reason
 
-    def _look(self) -> MotionHandle | None:
+    def _known(self):
+        try:
+            target = self.context.world_model.object(self.params.object)
+        except KeyError as error:
+            self.reason = error.args[0]
+            return None
+        if target.held_by is None and self.context.world_model.surface_under(target.position) is None:
+            self.reason = f"the {target.name} is not on any surface I know"
+            return None
+        return target
+
+    def _turn_head(self, angle: float) -> MotionHandle | None:
+        if self.target is not None:
+            return None
+        pan = next((j for j in self.context.robot_config.groups.get("head", []) if "pan" in j), None)
+        return self.context.robot.joints.move({pan: angle}) if pan else None
+
+    def _look(self) -> None:
+        if self.target is None:
+            self.context.perceiver.look()
+            self.target = self._known()
+
+    def _look_at_it(self) -> MotionHandle | None:
+        if self.target is None:
+            raise PhaseFailure(f"{self.reason}; looked around from here")
         if self.target.held_by is not None:
             return None  # in hand: found
         return self.context.robot.whole_body.look_at(self.target.position)

@@ -22,13 +22,13 @@ def place_object(run: MissionRun, name: str, x: float, y: float, yaw: float) -> 
     """Stand object ``name`` upright at (x, y) on the surface there, turned ``yaw`` rad; re-seed the WorldModel."""
     if run.sim.time > 0.0:
         raise RuntimeError("place_object is set-up: call it before the run starts")
-    belief = run.context.world_model
-    surface = belief.surface_under(np.array([x, y, 10.0]))
+    declared = declared_world_model(run.context.world, run.sim.model)
+    surface = declared.surface_under(np.array([x, y, 10.0]))
     if surface is None:
         raise ValueError(f"({x:.2f}, {y:.2f}) is on no known surface")
     model, data = run.sim.model, run.sim.data
     body = model.body(run.context.world.objects[name].body)
-    obj = belief.object(name)
+    obj = declared.object(name)
     bottom_in_body = obj.position[2] - obj.size[2] / 2 - body.pos[2]  # for an upright body
     position = np.array([x, y, surface.height - bottom_in_body + DROP])
     quat = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
@@ -38,4 +38,4 @@ def place_object(run: MissionRun, name: str, x: float, y: float, yaw: float) -> 
     for qpos in (data.qpos, model.qpos0):
         qpos[address : address + 7] = np.concatenate([position, quat])
     mujoco.mj_forward(model, data)
-    run.context.world_model = declared_world_model(run.context.world, model)
+    run.context.world_model = run.initial_world_model()  # told where it is now, unless the camera must find it
