@@ -63,3 +63,51 @@ def test_the_mug_on_the_counter_and_the_ball_on_the_shelf():
 )
 def test_colour_names(rgb, name):
     assert colour_name(np.array(rgb)) == name
+
+
+def _camera_run(robot_start, tree=None):
+    mission = {"mission": "perceive", "perception": "camera", "tree": tree or {"wait": {"seconds": 0}}}
+    return build_run(mission, robot_start=robot_start)
+
+
+def test_objects_are_unknown_until_seen_then_fused_over_frames():
+    run = _camera_run((2.0, 0.0, 0.0))
+    belief = run.context.world_model
+    assert belief.objects == {}, "with perception: camera the robot starts knowing no objects"
+    for _ in range(3):
+        run.perceiver.look()
+    cube = belief.object("red cube")
+    assert cube.kind == "cube" and cube.colour == "red" and cube.confidence == pytest.approx(1.0)
+    assert np.linalg.norm(cube.position - run.truth.object_centre("red cube")) < 0.01
+    assert sum(cube.votes.values()) == 3
+    assert belief.object("water bottle").kind == "bottle"  # the world's name for a blue bottle
+
+
+def test_an_object_that_is_gone_loses_confidence_when_its_place_is_in_view():
+    run = _camera_run((2.0, 0.0, 0.0))
+    run.perceiver.look()
+    cube = run.context.world_model.object("red cube")
+    address = run.sim.model.joint("red_cube").qposadr[0]
+    run.sim.data.qpos[address + 2] = -5.0  # the fault: the cube vanishes (someone took it)
+    run.sim.step()
+    for _ in range(4):
+        run.perceiver.look()
+    assert cube.confidence == 0.0
+    with pytest.raises(KeyError, match="I do not know where the red cube is now"):
+        run.context.world_model.object("red cube")
+
+
+def test_find_looks_around_for_an_object_it_has_not_seen():
+    run = _camera_run((2.2, -0.9, 120.0), {"find": {"object": "red cube"}})  # the table is off to the right
+    result = run.execute()
+    assert result.tree_status == "SUCCESS", result.summary()
+    assert run.perceiver.frames >= 2
+    seen = run.context.world_model.object("red cube").position
+    assert np.linalg.norm(seen - run.truth.object_centre("red cube")) < 0.01
+
+
+def test_find_says_what_it_could_not_find():
+    run = _camera_run((0.0, 3.0, 90.0), {"find": {"object": "coffee mug"}})  # facing the shelf, the mug elsewhere
+    result = run.execute()
+    assert result.tree_status == "FAILURE"
+    assert "I have not seen the coffee mug (a white mug) yet; looked around from here" in result.cause
