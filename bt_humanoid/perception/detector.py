@@ -53,6 +53,7 @@ class Detection:
     surface: str
     pixels: int
     visible_fraction: float  # of the footprint seen from above (occlusion), 0..1
+    yaw_known: bool = True  # false for a mug whose handle was not seen (its yaw is a guess)
 
 
 def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
@@ -132,6 +133,7 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     flatness = float(np.mean(heights > top - FLAT_BAND))
     tapering = near_top / max(middle, 1e-6)
     centre, diameter, handle = _cylinder(band)
+    yaw_known = True
     if width < MIN_WIDTH:
         return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
     if top > TALL * width:
@@ -155,11 +157,15 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
         if kind in ("mug", "can") and len(flat_top) >= WELL_SEEN_TOP:
             centre, diameter = _circle(flat_top)  # the rim: the body alone (a mug's handle is lower)
         size = np.array([diameter, diameter, top])
-        yaw = math.atan2(handle[1], handle[0]) if handle is not None else 0.0
+        if handle is not None:
+            yaw = math.atan2(handle[1], handle[0])
+        else:  # a mug whose handle is not seen has it behind, pointing away from the camera
+            sight = centre - eye[:2]
+            yaw, yaw_known = math.atan2(sight[1], sight[0]), kind not in ("mug",)
     position = np.array([centre[0], centre[1], surface.height + top / 2])
     visible = min(1.0, _area(band) / max(_footprint_area(kind, size), 1e-9))
     colour = colour_name(np.median(colours, axis=0))
-    return Detection(kind, colour, position, size, yaw, surface.name, len(points), visible)
+    return Detection(kind, colour, position, size, yaw, surface.name, len(points), visible, yaw_known)
 
 
 def _boxy(flat_top: np.ndarray, flatness: float, top: float, width: float) -> bool:

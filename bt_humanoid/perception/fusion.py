@@ -62,6 +62,7 @@ def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject
         colour=detection.colour,
         position=detection.position.copy(),
         yaw=detection.yaw,
+        yaw_known=detection.yaw_known,
         size=detection.size.copy(),
         confidence=GAIN,
         last_seen=time,
@@ -79,8 +80,8 @@ def _update(tracked: TrackedObject, detection: Detection, time: float) -> None:
     tracked.last_seen = time
     tracked.votes[(detection.kind, detection.colour)] += 1
     (kind, colour), _ = tracked.votes.most_common(1)[0]
-    if detection.kind == "mug" or kind != "mug":
-        tracked.yaw = detection.yaw  # only a view that saw the handle knows a mug's yaw
+    if detection.yaw_known or not tracked.yaw_known:  # a seen handle beats any guess
+        tracked.yaw, tracked.yaw_known = detection.yaw, detection.yaw_known
     tracked.kind, tracked.colour = kind, colour
     tracked.name = f"{colour} {kind}"
     tracked.keep_upright = kind in ("bottle", "mug", "can")

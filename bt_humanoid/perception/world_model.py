@@ -33,6 +33,7 @@ class TrackedObject:
     keep_upright: bool = False
     held_by: str | None = None  # gripper side while the robot holds it
     grip_offset: float = 0.0  # m the grip site sits above the centre, while held
+    yaw_known: bool = True  # false while a mug's handle has not been seen (its yaw is a guess)
     votes: Counter = field(default_factory=Counter)  # (kind, colour) → sightings, when perception tracks it
 
     @property

@@ -205,6 +205,8 @@ class Grasp(_ManipulationSkill):
         held = self.context.world_model.held(side)
         if held is not None:
             raise PhaseFailure(f"the {side} hand already holds the {held.name}")
+        if self.context.perceiver is not None:
+            self.context.perceiver.look()  # a fresh, close look: a mug's handle shows from here if anywhere
         self.target = self._object(self.params.object)
         surface = self.context.world_model.surface_under(self.target.position)
         if surface is None:
