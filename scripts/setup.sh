@@ -23,5 +23,7 @@ if [ ! -x .venv/bin/python ]; then
   "$python" -m venv .venv
 fi
 .venv/bin/python -m pip install -q --upgrade pip
+# torch first, pinned: the CPU build (anything that lets pip choose pulls a newer one with GBs of CUDA)
+.venv/bin/python -m pip install -q "torch==2.13.0"
 .venv/bin/python -m pip install -q -e ".[test]"
 echo "bt-humanoid is set up in .venv"

@@ -1,0 +1,96 @@
+"""Grounding phrases to the apartment's objects: a fixed test set, with ambiguity and things that are not there.
+
+The WorldModel here is the one the world declares (five objects: red and blue
+cubes and a water bottle on the table, a coffee mug on the counter, a yellow
+ball on the shelf), so the test is about language, not detection.
+"""
+
+import pytest
+
+from bt_humanoid.perception.grounding import ground
+from bt_humanoid.testing.scenario import build_run
+
+FOUND = {
+    "the red cube": "red cube",
+    "red cube": "red cube",
+    "the blue cube": "blue cube",
+    "the blue block": "blue cube",
+    "the red block": "red cube",
+    "the red thing": "red cube",
+    "the bottle": "water bottle",
+    "the water bottle": "water bottle",
+    "water bottle": "water bottle",
+    "the blue bottle": "water bottle",
+    "the bottle on the table": "water bottle",
+    "the mug": "coffee mug",
+    "the coffee mug": "coffee mug",
+    "the cup": "coffee mug",
+    "the white cup": "coffee mug",
+    "the cup on the counter": "coffee mug",
+    "the mug from the counter": "coffee mug",
+    "the ball": "yellow ball",
+    "the yellow ball": "yellow ball",
+    "the yellow thing": "yellow ball",
+    "the ball on the shelf": "yellow ball",
+    "the thing on the shelf": "yellow ball",
+    "the thing on the counter": "coffee mug",
+    "the red cube on the table": "red cube",
+    "the blue cube on the table": "blue cube",
+    "the biggest thing": "water bottle",
+    "the tallest object": "water bottle",
+    "the large bottle": "water bottle",
+    "coffee": "coffee mug",
+    "a sphere": "yellow ball",
+    "something to play with": "yellow ball",
+}
+AMBIGUOUS = [
+    "the cube",
+    "the block",
+    "the blue thing",
+    "the cube on the table",
+    "the thing on the table",
+    "the smallest thing",
+    "something to drink",
+]
+NOT_THERE = [
+    "the purple elephant",
+    "the green cube",
+    "the mug on the table",
+    "the cube on the counter",
+    "the red ball",
+    "the white bottle",
+    "the banana",
+]
+
+
+@pytest.fixture(scope="module")
+def belief():
+    return build_run({"mission": "words", "tree": {"wait": {"seconds": 0}}}).context.world_model
+
+
+def test_the_set_is_big_enough():
+    assert len(FOUND) + len(AMBIGUOUS) + len(NOT_THERE) >= 40
+
+
+def test_top_one_accuracy_on_phrases_that_name_one_object(belief):
+    wrong = {}
+    for phrase, expected in FOUND.items():
+        result = ground(phrase, belief)
+        got = result.best.name if result.best is not None else f"{result.verdict}: {result.message}"
+        if got != expected:
+            wrong[phrase] = got
+    assert len(wrong) <= 0.05 * len(FOUND), wrong
+
+
+@pytest.mark.parametrize("phrase", AMBIGUOUS)
+def test_ambiguous_phrases_are_flagged_with_the_choices(phrase, belief):
+    result = ground(phrase, belief)
+    assert result.verdict == "ambiguous", result.message
+    assert result.message.startswith("which one do you mean: the ")
+
+
+@pytest.mark.parametrize("phrase", NOT_THERE)
+def test_phrases_naming_nothing_present_are_not_found(phrase, belief):
+    result = ground(phrase, belief)
+    assert result.verdict == "not found", f"{result.verdict}: {result.message}"
+    assert f"I see nothing that is {phrase!r}" in result.message
