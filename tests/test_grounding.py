@@ -94,3 +94,20 @@ def test_phrases_naming_nothing_present_are_not_found(phrase, belief):
     result = ground(phrase, belief)
     assert result.verdict == "not found", f"{result.verdict}: {result.message}"
     assert f"I see nothing that is {phrase!r}" in result.message
+
+
+def _find(phrase: str):
+    run = build_run({"mission": "find it", "tree": {"find": {"object": phrase, "remember_as": "it"}}})
+    return run, run.execute()
+
+
+def test_find_grounds_a_phrase_and_remembers_the_object():
+    run, result = _find("the cup on the counter")
+    assert result.tree_status == "SUCCESS", result.summary()
+    assert run.context.blackboard.get("it") == run.context.world_model.object("coffee mug").id
+
+
+def test_find_asks_which_one_when_the_phrase_fits_two():
+    _, result = _find("the cube")
+    assert result.tree_status == "FAILURE"
+    assert "which one do you mean: the red cube or the blue cube?" in result.cause

@@ -1,9 +1,12 @@
 """Skills that locate things: find.
 
 ``find`` asks the WorldModel where an object is believed to be and turns the
-head camera onto it. When the robot has a camera in the loop and does not
+head camera onto it. A phrase that is not a name is grounded
+(``perception/grounding.py``): "the cup on the counter" finds the mug, "the
+cube" asks which one. When the robot has a camera in the loop and does not
 know the object yet, it looks ahead, left and right first. It fails with the
-reason when it still does not know (searching other rooms comes next).
+reason when it still does not know (searching other rooms comes next). The
+found object's id goes to the blackboard (``remember_as``) for later leaves.
 """
 
 from __future__ import annotations
@@ -11,9 +14,8 @@ from __future__ import annotations
 from pydantic import Field
 
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.perception.grounding import ground
 from bt_humanoid.skills.manipulation_skills import _ManipulationSkill
-from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel
@@ -22,16 +24,13 @@ LOOK_AROUND = (0.0, 1.0, -1.0)  # head pan (rad) of each look when the object is
 
 
 class FindParams(StrictModel):
-    object: str = Field(description="the object to find (from the world model)")
+    object: str = Field(description='a name ("red cube") or a phrase ("the cup on the counter", "something to drink")')
+    remember_as: str = Field("found", description="blackboard key that gets the found object's id, for later leaves")
 
 
 @skill("find", "locate an object: recall where it is believed to be, or look around for it, and look at it")
 class Find(_ManipulationSkill):
     Params = FindParams
-
-    @classmethod
-    def check(cls, params: FindParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.object, context.world.objects, "object", "object")
 
     def phases(self):
         phases = [("recall", self._recall)]
@@ -42,14 +41,21 @@ class Find(_ManipulationSkill):
     def _recall(self) -> None:
         self.target = self._known()
         if self.target is None and self.context.perceiver is None:
-            self.target = self._object(self.params.object)  # raises with the reason
+            raise PhaseFailure(self.reason)  # no camera to look around with
 
     def _known(self):
+        belief, phrase = self.context.world_model, self.params.object
         try:
-            target = self.context.world_model.object(self.params.object)
+            target = belief.object(phrase)
         except KeyError as error:
             self.reason = error.args[0]
-            return None
+            if phrase in belief.vocabulary or any(o.name == phrase for o in belief.objects.values()):
+                return None  # a name it knows: the reason says what is wrong with it
+            grounding = ground(phrase, belief)
+            if grounding.verdict != "found":
+                self.reason = grounding.message  # which one do you mean / I see nothing that is …
+                return None
+            target = grounding.best
         if target.held_by is None and self.context.world_model.surface_under(target.position) is None:
             self.reason = f"the {target.name} is not on any surface I know"
             return None
@@ -69,6 +75,7 @@ class Find(_ManipulationSkill):
     def _look_at_it(self) -> MotionHandle | None:
         if self.target is None:
             raise PhaseFailure(f"{self.reason}; looked around from here")
+        self.context.blackboard.set(self.params.remember_as, self.target.id)
         if self.target.held_by is not None:
             return None  # in hand: found
         return self.context.robot.whole_body.look_at(self.target.position)
