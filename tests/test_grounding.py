@@ -5,9 +5,11 @@ cubes and a water bottle on the table, a coffee mug on the counter, a yellow
 ball on the shelf), so the test is about language, not detection.
 """
 
+import numpy as np
 import pytest
 
 from bt_humanoid.perception.grounding import ground
+from bt_humanoid.perception.scene_graph import Relation, scene_graph
 from bt_humanoid.testing.scenario import build_run
 
 FOUND = {
@@ -65,7 +67,7 @@ NOT_THERE = [
 
 @pytest.fixture(scope="module")
 def belief():
-    return build_run({"mission": "words", "tree": {"wait": {"seconds": 0}}}).context.world_model
+    return belief_of_apartment()
 
 
 def test_the_set_is_big_enough():
@@ -111,3 +113,38 @@ def test_find_asks_which_one_when_the_phrase_fits_two():
     _, result = _find("the cube")
     assert result.tree_status == "FAILURE"
     assert "which one do you mean: the red cube or the blue cube?" in result.cause
+
+
+RELATIONAL = {  # seen from the west of the table, looking east: the bottle is left of both cubes
+    "the cube next to the bottle": "red cube",
+    "the cube left of the blue cube": "red cube",
+    "the cube to the right of the red cube": "blue cube",
+    "the bottle near the red cube": "water bottle",
+}
+
+
+@pytest.mark.parametrize(("phrase", "expected"), RELATIONAL.items())
+def test_relations_between_objects_seen_from_the_robot(phrase, expected, belief):
+    result = ground(phrase, belief, viewer=np.array([2.0, 0.0, 0.0]))
+    assert result.best is not None and result.best.name == expected, result.message
+
+
+def test_relations_that_hold_for_nothing_or_for_two():
+    viewer = np.array([2.0, 0.0, 0.0])
+    assert ground("the cube left of the bottle", belief_of_apartment(), viewer).verdict == "not found"
+    assert ground("the cube right of the bottle", belief_of_apartment(), viewer).verdict == "ambiguous"
+    assert (
+        "I see nothing that is 'the elephant'" in ground("the cube left of the elephant", belief_of_apartment()).message
+    )
+
+
+def test_the_scene_graph_says_what_stands_where():
+    facts = set(scene_graph(belief_of_apartment(), np.array([2.0, 0.0, 0.0])))
+    assert Relation("coffee_mug", "on", "counter") in facts
+    assert Relation("red_cube", "near", "water_bottle") in facts
+    assert Relation("water_bottle", "left_of", "red_cube") in facts
+    assert Relation("blue_cube", "right_of", "red_cube") in facts
+
+
+def belief_of_apartment():
+    return build_run({"mission": "words", "tree": {"wait": {"seconds": 0}}}).context.world_model

