@@ -111,3 +111,15 @@ def test_find_says_what_it_could_not_find():
     result = run.execute()
     assert result.tree_status == "FAILURE"
     assert "I have not seen the coffee mug (a white mug) yet; looked around from here" in result.cause
+
+
+def test_find_searches_the_places_for_an_object_in_another_room():
+    tree = {"find": {"object": "coffee mug", "remember_as": "mug"}}
+    run = _camera_run((0.5, -2.4, -90.0), tree)  # in the living room; the mug is on the kitchen counter
+    contacts: list = []
+    run.executor.observers.append(lambda: contacts.extend(run.truth.robot_contacts()))
+    result = run.execute()
+    assert result.tree_status == "SUCCESS", result.summary()
+    found = run.context.world_model.object(run.context.blackboard.get("mug"))
+    assert np.linalg.norm(found.position - run.truth.object_centre("coffee mug")) < 0.02
+    assert contacts == []

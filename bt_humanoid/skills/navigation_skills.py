@@ -15,7 +15,7 @@ from pydantic import Field, model_validator
 
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
-from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE
 from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
@@ -42,19 +42,23 @@ class _BaseSkill(PhasedSkill):
         return self.context.robot.joints.move(dict(posture)) if posture else None
 
     def _tuck_arms(self) -> MotionHandle | None:
-        """Fold every empty arm inside the footprint (an arm that carries something keeps its carry pose)."""
-        config = self.context.robot_config
-        tucked = config.postures.get(TUCKED_POSTURE, {})
-        joints = {
-            j: tucked[j]
-            for side in config.grippers
-            if self.context.world_model.held(side) is None
-            for j in config.groups.get(f"{side}_arm", [])
-            if j in tucked
-        }
-        if not self.context.world_model.held_any():  # nothing to hold up: the torso comes down too
-            joints.update({j: 0.0 for j in config.groups.get("lift", [])})
-        return self.context.robot.joints.move(joints) if joints else None
+        return tuck_empty_arms(self.context)
+
+
+def tuck_empty_arms(context: SkillContext) -> MotionHandle | None:
+    """Fold every empty arm inside the footprint (an arm that carries something keeps its carry pose)."""
+    config = context.robot_config
+    tucked = config.postures.get(TUCKED_POSTURE, {})
+    joints = {
+        j: tucked[j]
+        for side in config.grippers
+        if context.world_model.held(side) is None
+        for j in config.groups.get(f"{side}_arm", [])
+        if j in tucked
+    }
+    if not context.world_model.held_any():  # nothing to hold up: the torso comes down too
+        joints.update({j: 0.0 for j in config.groups.get("lift", [])})
+    return context.robot.joints.move(joints) if joints else None
 
 
 class NavigateToParams(StrictModel):

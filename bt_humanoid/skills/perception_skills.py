@@ -11,21 +11,27 @@ found object's id goes to the blackboard (``remember_as``) for later leaves.
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 from pydantic import Field
 
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.perception.grounding import ground
 from bt_humanoid.skills.manipulation_skills import _ManipulationSkill
+from bt_humanoid.skills.navigation_skills import tuck_empty_arms
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel
 
 LOOK_AROUND = (0.0, 1.0, -1.0)  # head pan (rad) of each look when the object is not known yet
+SEARCH_SPEED = 0.6  # m/s between places while searching
 
 
 class FindParams(StrictModel):
     object: str = Field(description='a name ("red cube") or a phrase ("the cup on the counter", "something to drink")')
     remember_as: str = Field("found", description="blackboard key that gets the found object's id, for later leaves")
+    search: bool = Field(True, description="if it is not in sight, go through the named places looking for it")
 
 
 @skill("find", "locate an object: recall where it is believed to be, or look around for it, and look at it")
@@ -33,10 +39,33 @@ class Find(_ManipulationSkill):
     Params = FindParams
 
     def phases(self):
-        phases = [("recall", self._recall)]
-        for angle in LOOK_AROUND:  # not known yet: look left, ahead and right with the head camera
-            phases += [("look around", lambda a=angle: self._turn_head(a)), ("look around", self._look)]
+        phases = [("recall", self._recall), *self._look_around("here")]
+        if self.params.search and self.context.navigator is not None and self.context.perceiver is not None:
+            # still not seen: fold the arms, go through the named places, nearest first, and look around at each
+            here = self.context.robot.base.pose()[:2]
+
+            def distance(item) -> float:
+                return float(np.hypot(*(np.array(item[1].pose[:2]) - here)))
+
+            phases.append(("fold the arms to search", lambda: None if self.target else tuck_empty_arms(self.context)))
+            for name, place in sorted(self.context.world.places.items(), key=distance):
+                phases += [(f"search the {name}", lambda p=place: self._go(p)), *self._look_around(name)]
         return [*phases, ("look at it", self._look_at_it)]
+
+    def _look_around(self, where: str) -> list:
+        label = f"look around {where}"
+        phases = []
+        for angle in LOOK_AROUND:  # look ahead, left and right with the head camera
+            phases += [(label, lambda a=angle: self._turn_head(a)), (label, self._look)]
+        return phases
+
+    def _go(self, place) -> MotionHandle | None:
+        if self.target is not None:
+            return None
+        x, y, yaw = place.pose
+        goal = np.array([x, y, math.radians(yaw)])
+        handle = self.context.navigator.go_to(goal, min(SEARCH_SPEED, self.context.max_base_speed))
+        return None if handle.done else handle  # a place it cannot reach is skipped
 
     def _recall(self) -> None:
         self.target = self._known()
@@ -74,7 +103,8 @@ class Find(_ManipulationSkill):
 
     def _look_at_it(self) -> MotionHandle | None:
         if self.target is None:
-            raise PhaseFailure(f"{self.reason}; looked around from here")
+            where = "here and in every place I know" if self.params.search and self.context.navigator else "from here"
+            raise PhaseFailure(f"{self.reason}; looked around {where}")
         self.context.blackboard.set(self.params.remember_as, self.target.id)
         if self.target.held_by is not None:
             return None  # in hand: found
