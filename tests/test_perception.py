@@ -107,7 +107,8 @@ def test_find_looks_around_for_an_object_it_has_not_seen():
 
 
 def test_find_says_what_it_could_not_find():
-    run = _camera_run((0.0, 3.0, 90.0), {"find": {"object": "coffee mug"}})  # facing the shelf, the mug elsewhere
+    tree = {"find": {"object": "coffee mug", "search": False}}  # only look around from here
+    run = _camera_run((0.0, 3.0, 90.0), tree)  # facing the shelf, the mug elsewhere
     result = run.execute()
     assert result.tree_status == "FAILURE"
     assert "I have not seen the coffee mug (a white mug) yet; looked around from here" in result.cause
