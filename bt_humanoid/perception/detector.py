@@ -35,6 +35,7 @@ TOP_BAND = 0.03  # m below the highest point that outlines the footprint
 FLAT_BAND = 0.006  # m below the highest point that counts as a flat top
 RESTING = 0.03  # m: a region whose lowest point is higher above the surface is held, not resting
 MUG_PROPORTION = 1.4  # height / diameter below which a round thing without a visible handle is a mug
+MIN_MUG_HEIGHT = 0.065  # m: a common-sense prior, cups and mugs are taller than this
 SQUARE = 0.87  # share of its bounding rectangle a flat top fills, above which it is a box's (a disc fills π/4)
 TALL = 2.0  # height / width above which a thing is a bottle
 BALL_TAPER = 0.8  # a ball is much narrower near its top than at its middle...
@@ -138,19 +139,20 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
         return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
     if top > TALL * width:
         kind = "bottle"
-    elif handle is not None:
+    elif handle is not None and top >= MIN_MUG_HEIGHT:
         kind = "mug"
     elif tapering < BALL_TAPER and flatness < BALL_FLATNESS:
         kind = "ball"
         centre, diameter = _circle(band)
-    elif _boxy(flat_top, flatness, top, width):
+    elif _boxy(flat_top, flatness, top, width) or top < MIN_MUG_HEIGHT:  # too low for a cup: a small box
         kind = "box"
     else:
         kind = "mug" if top < MUG_PROPORTION * diameter else "can"
     if kind == "box":
         (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
         narrow, long = sorted((side_a, side_b))
-        kind = "cube" if long < 1.25 * narrow and abs(top - long) < 0.3 * long else "box"
+        # one view foreshortens a side: a cube is as tall as it is long, give or take what a view hides
+        kind = "cube" if long < 1.6 * narrow and abs(top - long) < 0.4 * long else "box"
         centre, size = np.array([cx, cy]), np.array([long, narrow, top])
         yaw = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
     else:
