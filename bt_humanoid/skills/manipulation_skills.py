@@ -281,6 +281,9 @@ class Grasp(_ManipulationSkill):
         # a failed grasp leaves the hand open and above the object, ready for another attempt
         if self.phase in ("descend", "close"):
             self.context.robot.grippers.command(self.params.side, "open")
+        if self.phase == "descend" and self.target.kind == "mug" and not self.target.yaw_known:
+            # blocked on the way down: most likely a finger on the handle, which is not where it was guessed
+            self.target.yaw += math.pi / 2
 
 
 # --------------------------------------------------------------------------- put
