@@ -140,7 +140,11 @@ class MissionRun:
 
     def execute(self) -> RunResult:
         started = time.perf_counter()
-        status = self.executor.run(max_time=self.time_budget + 1.0)
+        try:
+            status = self.executor.run(max_time=self.time_budget + 1.0)
+        finally:
+            if self.perceiver is not None:
+                self.perceiver.close()  # its off-screen GL contexts: one per run adds up over a benchmark
         wall = time.perf_counter() - started
         conditions = [check_condition(c, self.truth) for c in self.spec.header.success]
         violation = self.supervisor.violation

@@ -50,6 +50,12 @@ class Perceiver:
     def halt(self) -> None:
         pass  # nothing moves
 
+    def close(self) -> None:
+        """Free the renderers; ``look()`` cannot be called afterwards."""
+        self.camera.close()
+        self._segmentation.close()
+        self.period = math.inf  # no more background looks
+
     def look(self) -> list[Detection]:
         """Capture a frame now, detect objects in it and fuse them into the WorldModel."""
         self.last_look = self.sim.time
