@@ -8,12 +8,11 @@ Runs pinned to one CPU core. Prints a table; ``--json PATH`` also writes it.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import statistics
 import time
 from pathlib import Path
 
+from bt_humanoid.benchmarks.common import pin_to_one_core, save_figures
 from bt_humanoid.paths import missions_dir
 from bt_humanoid.testing.scenario import build_run
 
@@ -109,8 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path, help="also write the figures here")
     args = parser.parse_args(argv)
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+    pin_to_one_core()
     print("bt-humanoid engine benchmark (one core)")
     figures = {"compile": bench_compile(), "tick": bench_tick_overhead(), "demo": bench_demo_rtf()}
     c = figures["compile"]
@@ -128,8 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         f"  demo mission: {d['sim_time_s']:.1f} s simulated, real-time factor {d['real_time_factor']:.1f}× "
         "(target ≥ 10×)"
     )
-    if args.json:
-        args.json.write_text(json.dumps(figures, indent=2) + "\n")
+    save_figures(args.json, figures)
     return 0
 
 

@@ -17,9 +17,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import json
 import math
-import os
 import statistics
 import time
 from dataclasses import dataclass
@@ -27,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bt_humanoid.benchmarks.common import percentile, pin_to_one_core, save_figures
 from bt_humanoid.navigation.grid_astar import grid_route_length
 from bt_humanoid.testing.scenario import build_run
 
@@ -125,11 +124,6 @@ def run_one(start: tuple[float, float, float], goal: str, world: str = "apartmen
     )
 
 
-def _percentile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--starts", type=int, default=20, help="random start poses (default 20)")
@@ -142,8 +136,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.starts < 1:
         parser.error("--starts must be at least 1")
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+    pin_to_one_core()
     started = time.perf_counter()
     starts = random_starts(args.starts, np.random.default_rng(args.seed), args.world)
     total = len(starts) * len(args.goals)
@@ -176,7 +169,7 @@ def main(argv: list[str] | None = None) -> int:
         "runs_with_contacts": sum(1 for o in outcomes if o.contacts),
         "average_speed": sum(o.distance for o in outcomes) / drive if drive > 0 else 0.0,
         "planning_median_ms": statistics.median(plans) if plans else None,
-        "planning_p95_ms": _percentile(plans, 0.95) if plans else None,
+        "planning_p95_ms": percentile(plans, 0.95) if plans else None,
         "route_vs_grid_astar_median": statistics.median(ratios) if ratios else None,
         "route_vs_grid_astar_max": max(ratios) if ratios else None,
         "failures": [{"start": o.start, "goal": o.goal, "failure": o.failure} for o in outcomes if not o.success],
@@ -200,8 +193,7 @@ def main(argv: list[str] | None = None) -> int:
             f"worst {figures['route_vs_grid_astar_max']:.2f}"
         )
     print(f"  wall time {figures['wall_s']:.0f} s")
-    if args.json:
-        args.json.write_text(json.dumps(figures, indent=2) + "\n")
+    save_figures(args.json, figures)
     return 0
 
 

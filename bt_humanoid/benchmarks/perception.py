@@ -20,9 +20,7 @@ latency per frame (rendering timed apart). Pinned to one CPU core;
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import os
 import statistics
 import time
 from dataclasses import dataclass
@@ -31,6 +29,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from bt_humanoid.benchmarks.common import pin_to_one_core, save_figures
 from bt_humanoid.perception.detector import detect
 from bt_humanoid.perception.rgbd_camera import RgbdCamera
 from bt_humanoid.testing.scenario import build_run
@@ -191,8 +190,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.scenes < 1:
         parser.error("--scenes must be at least 1")
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+    pin_to_one_core()
     rng = np.random.default_rng(args.seed)
     print(f"bt-humanoid perception benchmark: {args.scenes} scenes, seed {args.seed} (one core)")
     started = time.perf_counter()
@@ -272,8 +270,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     for miss in misses[:15]:
         print(f"    {miss}")
-    if args.json:
-        args.json.write_text(json.dumps(figures, indent=2) + "\n")
+    save_figures(args.json, figures)
     return 0
 
 

@@ -103,6 +103,7 @@ class WholeBodyController:
         self.reference = np.zeros(len(self.names))
         self.base_target = np.zeros(3)  # pose the base holds during and after a whole-body goal
         self.solve_times: deque[float] = deque(maxlen=100_000)  # wall seconds per QP, for benchmarks
+        self.conic_times: deque[float] = deque(maxlen=100_000)  # of which in the conic solver
         self.dt = 0.01
 
     # ------------------------------------------------------------------ queries
@@ -226,6 +227,7 @@ class WholeBodyController:
         self.kinematics.update(self.reference)
         solution = solve_ik(self.kinematics, goal.tasks, goal.box_limits, goal.limits, self.dt)
         self.solve_times.append(solution.solve_time)
+        self.conic_times.append(solution.conic_time)
         goal.failures = 0 if solution.solved else goal.failures + 1
         if goal.failures >= FAILED_SOLVES:
             self._finish(goal, False, "whole-body QP has no solution: the target breaks a joint or safety limit")

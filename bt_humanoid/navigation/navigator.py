@@ -62,7 +62,7 @@ class Navigator:
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
         self.last_scan = -math.inf
         self.follower = RouteFollower(robot.base, config.base, robot.control_period)
-        self.head_pan = next((j for j in config.groups.get("head", []) if "pan" in j), None)
+        self.head_pan = config.head_pan
         self.goal: np.ndarray | None = None
         self.max_speed = config.base.limits.max_speed
         self.replans = 0
@@ -110,9 +110,11 @@ class Navigator:
         if self.camera is not None and now - self.last_scan >= self.scan_period - 1e-9:
             self.last_scan = now
             self._update_map()
-            if self.waiting_since is not None or self._route_ahead_blocked():
+            blocked_at = self._blocked_at()
+            if self.waiting_since is not None or blocked_at is not None:
                 self._replan(now)
-            self.follower.stop_at = self._blocked_at()
+                blocked_at = self._blocked_at()  # on the new route, if there is one
+            self.follower.stop_at = blocked_at
             self.follower.speed_limit = self._speed_near_obstacles()
             self._look_along_route()
         if self.handle is None:
@@ -193,9 +195,10 @@ class Navigator:
         if route is None or self.follower.route is None:
             return None
         s = self.follower.progress
-        ahead = (route.arc_length > s + 0.1) & (route.arc_length <= s + LOOKAHEAD)
-        blocked = ahead & (self.grid.clearance_at(route.points) < self.clearance.minimum)
-        return float(route.arc_length[np.argmax(blocked)]) if np.any(blocked) else None
+        # ahead of where the base stands (it may have started close to something), up to LOOKAHEAD
+        ahead = np.nonzero((route.arc_length > s + 0.1) & (route.arc_length <= s + LOOKAHEAD))[0]
+        blocked = ahead[self.grid.clearance_at(route.points[ahead]) < self.clearance.minimum]
+        return float(route.arc_length[blocked[0]]) if len(blocked) else None
 
     def _settle(self, motion: MotionHandle | None) -> None:
         if motion is not None and motion.status.name == "SUCCEEDED":
@@ -213,23 +216,10 @@ class Navigator:
             self.follower.stop()
         self.goal = None
 
-    def _route_ahead_blocked(self) -> bool:
-        route = self.route
-        if route is None or self.follower.route is None:
-            return False
-        s = self.follower.progress
-        ahead = (route.arc_length >= s) & (route.arc_length <= s + LOOKAHEAD)
-        points = route.points[ahead]
-        if len(points) == 0:
-            return False
-        needed = self.clearance.required(points, route.points[0], route.points[-1])
-        # the part the base stands in now may be tight (it started there): judge the rest
-        return bool(np.any(self.grid.clearance_at(points) < np.minimum(needed, self.clearance.minimum)))
-
-    def _update_map(self) -> bool:
-        """Add what the depth camera sees, clear what it sees free; True if the map changed."""
+    def _update_map(self) -> None:
+        """Add what the depth camera sees, clear what it sees free."""
         if self.camera is None:
-            return False
+            return
         scan = self.camera.scan()
         base = self.robot.base.pose()[:2]
         hits = scan.hits
@@ -248,9 +238,9 @@ class Navigator:
         away_from_camera /= np.maximum(np.hypot(*away_from_camera.T), 1e-6)[:, None]
         depths = np.arange(0.0, SEEN_DEPTH + 1e-9, self.grid.resolution)
         behind = solid[:, None, :] + depths[None, :, None] * away_from_camera[:, None, :]
-        changed = self.grid.mark(behind.reshape(-1, 2))
+        self.grid.mark(behind.reshape(-1, 2))
         rows, cols = self._cells_seen_free(scan)
-        return self.grid.clear(rows, cols) or changed
+        self.grid.clear(rows, cols)
 
     def _cells_seen_free(self, scan: DepthScan) -> tuple[np.ndarray, np.ndarray]:
         """Cells that rays crossed low over the floor (below FREE_BELOW) before they ended."""

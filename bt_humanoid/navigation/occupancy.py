@@ -48,27 +48,23 @@ class OccupancyGrid:
     def occupied(self) -> np.ndarray:
         return self.static | self.observed
 
-    def mark(self, xy: np.ndarray) -> bool:
-        """Mark the cells under world points as seen occupied; True if anything changed."""
+    def mark(self, xy: np.ndarray) -> None:
+        """Mark the cells under world points as seen occupied."""
         rows, cols = self.cell(xy)
         keep = self.inside(rows, cols)
         rows, cols = rows[keep], cols[keep]
         new = ~self.observed[rows, cols] & ~self.static[rows, cols]
-        if not np.any(new):
-            return False
-        self.observed[rows[new], cols[new]] = True
-        self._clearance = None
-        return True
+        if np.any(new):  # the clearance field is recomputed only when something changed
+            self.observed[rows[new], cols[new]] = True
+            self._clearance = None
 
-    def clear(self, rows: np.ndarray, cols: np.ndarray) -> bool:
-        """Forget observed obstacles in these cells (seen free); True if anything changed."""
+    def clear(self, rows: np.ndarray, cols: np.ndarray) -> None:
+        """Forget observed obstacles in these cells (seen free)."""
         keep = self.inside(rows, cols)
         rows, cols = rows[keep], cols[keep]
-        if not np.any(self.observed[rows, cols]):
-            return False
-        self.observed[rows, cols] = False
-        self._clearance = None
-        return True
+        if np.any(self.observed[rows, cols]):
+            self.observed[rows, cols] = False
+            self._clearance = None
 
     def clear_observed(self) -> None:
         """Forget everything the camera added (the static map stays)."""

@@ -193,11 +193,8 @@ def _segment_valid(a: np.ndarray, b: np.ndarray, valid_points, step: float = SAM
 
 
 def _densify(corners: np.ndarray, spacing: float) -> np.ndarray:
-    points = [
-        np.linspace(a, b, max(2, math.ceil(np.hypot(*(b - a)) / spacing) + 1))[:-1]
-        for a, b in itertools.pairwise(corners)
-    ]
-    return np.concatenate([*points, corners[-1:]])
+    """The polyline with points at most ``spacing`` apart (so shortcuts may start between corners)."""
+    return np.concatenate([*(_line(a, b, spacing) for a, b in itertools.pairwise(corners)), corners[-1:]])
 
 
 def _shortcut(corners: np.ndarray, valid_points) -> np.ndarray:
@@ -244,10 +241,10 @@ def _round_corners(corners: np.ndarray, valid_points) -> tuple[np.ndarray, np.nd
     return points[keep], kappa[keep]
 
 
-def _line(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Points from a towards b (a included, b excluded) every SAMPLE_SPACING."""
+def _line(a: np.ndarray, b: np.ndarray, spacing: float = SAMPLE_SPACING) -> np.ndarray:
+    """Points from a towards b (a included, b excluded) at most ``spacing`` apart."""
     length = float(np.hypot(*(b - a)))
-    count = max(1, math.ceil(length / SAMPLE_SPACING))
+    count = max(1, math.ceil(length / spacing))
     return a + np.outer(np.arange(count) / count, b - a)
 
 

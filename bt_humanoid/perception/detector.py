@@ -53,7 +53,6 @@ class Detection:
     yaw: float  # rad; a mug's handle points along its x
     surface: str
     pixels: int
-    visible_fraction: float  # of the footprint seen from above (occlusion), 0..1
     yaw_known: bool = True  # false for a mug whose handle was not seen (its yaw is a guess)
 
 
@@ -165,9 +164,8 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
             sight = centre - eye[:2]
             yaw, yaw_known = math.atan2(sight[1], sight[0]), kind not in ("mug",)
     position = np.array([centre[0], centre[1], surface.height + top / 2])
-    visible = min(1.0, _area(band) / max(_footprint_area(kind, size), 1e-9))
     colour = colour_name(np.median(colours, axis=0))
-    return Detection(kind, colour, position, size, yaw, surface.name, len(points), visible, yaw_known)
+    return Detection(kind, colour, position, size, yaw, surface.name, len(points), yaw_known)
 
 
 def _boxy(flat_top: np.ndarray, flatness: float, top: float, width: float) -> bool:
@@ -201,10 +199,6 @@ def _fill(xy: np.ndarray) -> float:
 
 def _area(xy: np.ndarray) -> float:
     return float(cv2.contourArea(cv2.convexHull(xy.astype(np.float32)))) if len(xy) >= 3 else 0.0
-
-
-def _footprint_area(kind: str, size: np.ndarray) -> float:
-    return float(size[0] * size[1]) if kind in ("cube", "box") else math.pi * (size[0] / 2) ** 2
 
 
 def _circle(xy: np.ndarray) -> tuple[np.ndarray, float]:

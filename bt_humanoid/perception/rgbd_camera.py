@@ -40,6 +40,7 @@ class RgbdFrame:
         return self.position + camera @ self.rotation.T
 
 
+# shadows, reflections and the sky cost most of a frame's rendering time and tell the detector nothing
 _OFF = (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION, mujoco.mjtRndFlag.mjRND_SKYBOX)
 
 
@@ -72,13 +73,8 @@ class RgbdCamera:
 
     def _render(self, renderer: mujoco.Renderer) -> np.ndarray:
         renderer.update_scene(self.sim.data, camera=self.camera)
-        flags = renderer.scene.flags
-        for flag in (
-            mujoco.mjtRndFlag.mjRND_SHADOW,
-            mujoco.mjtRndFlag.mjRND_REFLECTION,
-            mujoco.mjtRndFlag.mjRND_SKYBOX,
-        ):
-            flags[flag] = 0
+        for flag in _OFF:
+            renderer.scene.flags[flag] = 0
         return renderer.render()
 
     def close(self) -> None:

@@ -97,6 +97,11 @@ class RobotConfig(StrictModel):
         return self.joint_limits["default"]
 
     @property
+    def head_pan(self) -> str | None:
+        """The head joint that turns the camera left and right (by name, in the head group), if any."""
+        return next((j for j in self.groups.get("head", []) if "pan" in j), None)
+
+    @property
     def actuated_joints(self) -> list[str]:
         """Every position-controlled joint: groups first, then gripper fingers."""
         joints = [j for group in self.groups.values() for j in group]

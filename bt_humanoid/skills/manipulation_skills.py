@@ -19,7 +19,7 @@ from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
-from bt_humanoid.perception.world_model import SupportSurface, TrackedObject
+from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.params import check_name
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
@@ -41,19 +41,7 @@ CARRY_TOLERANCE = (0.03, 0.2)  # m, rad: the carry pose needs no precision
 
 
 class _ManipulationSkill(PhasedSkill):
-    """Shared helpers: belief look-ups with clear errors, reach limits, the carry pose."""
-
-    def _object(self, name: str) -> TrackedObject:
-        try:
-            return self.context.world_model.object(name)
-        except KeyError as error:
-            raise PhaseFailure(error.args[0]) from None
-
-    def _surface(self, name: str) -> SupportSurface:
-        try:
-            return self.context.world_model.surface(name)
-        except KeyError as error:
-            raise PhaseFailure(error.args[0]) from None
+    """Shared helpers: reach limits, the carry pose."""
 
     def _keepout(self, surface: SupportSurface) -> Limit:
         radius = self.context.robot_config.base.footprint_radius + KEEPOUT_MARGIN

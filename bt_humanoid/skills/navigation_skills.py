@@ -61,6 +61,13 @@ def tuck_empty_arms(context: SkillContext) -> MotionHandle | None:
     return context.robot.joints.move(joints) if joints else None
 
 
+def _places_and_objects(params: NavigateToParams | TurnParams, context: CheckContext) -> list[tuple[str, str]]:
+    """The named place and object of a base skill's parameters exist in the world."""
+    return check_name(params.place, context.world.places, "place", "place") + check_name(
+        params.object, context.world.objects, "object", "object"
+    )
+
+
 class NavigateToParams(StrictModel):
     place: str | None = Field(None, description="a named place of the world")
     object: str | None = Field(None, description="an object: a stand-off pose facing it (from the world model)")
@@ -79,9 +86,7 @@ class NavigateTo(_BaseSkill):
 
     @classmethod
     def check(cls, params: NavigateToParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.place, context.world.places, "place", "place") + check_name(
-            params.object, context.world.objects, "object", "object"
-        )
+        return _places_and_objects(params, context)
 
     def phases(self):
         return [("look ahead", self._look_ahead), ("tuck the arms", self._tuck_arms), ("navigate", self._navigate)]
@@ -114,10 +119,7 @@ class NavigateTo(_BaseSkill):
     def _standoff(self, name: str) -> np.ndarray:
         """Facing the object: at the nearest edge of the surface it stands on, or beside it on the floor."""
         belief = self.context.world_model
-        try:
-            obj = belief.object(name)
-        except KeyError as error:
-            raise PhaseFailure(error.args[0]) from None
+        obj = self._object(name)
         config = self.context.robot_config
         here = self.context.robot.base.pose()
         surface = belief.surface_under(obj.position) if obj.held_by is None else None
@@ -154,9 +156,7 @@ class Turn(_BaseSkill):
 
     @classmethod
     def check(cls, params: TurnParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.place, context.world.places, "place", "place") + check_name(
-            params.object, context.world.objects, "object", "object"
-        )
+        return _places_and_objects(params, context)
 
     def phases(self):
         return [("turn", self._turn)]
@@ -170,10 +170,7 @@ class Turn(_BaseSkill):
             if p.place is not None:
                 target = np.array(self.context.world.place(p.place).pose[:2])
             else:
-                try:
-                    target = self.context.world_model.object(p.object).position[:2]
-                except KeyError as error:
-                    raise PhaseFailure(error.args[0]) from None
+                target = self._object(p.object).position[:2]
             heading = math.atan2(target[1] - y, target[0] - x)
         return self.context.robot.base.move_to(x, y, heading)
 

@@ -93,7 +93,7 @@ class Find(_ManipulationSkill):
     def _turn_head(self, angle: float) -> MotionHandle | None:
         if self.target is not None:
             return None
-        pan = next((j for j in self.context.robot_config.groups.get("head", []) if "pan" in j), None)
+        pan = self.context.robot_config.head_pan
         return self.context.robot.joints.move({pan: angle}) if pan else None
 
     def _look(self) -> None:

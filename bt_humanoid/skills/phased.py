@@ -12,6 +12,7 @@ from collections.abc import Callable
 from py_trees.common import Status
 
 from bt_humanoid.control.motion import MotionHandle, MotionStatus
+from bt_humanoid.perception.world_model import SupportSurface, TrackedObject
 from bt_humanoid.skills.base import Skill
 
 Phase = tuple[str, Callable[[], MotionHandle | None]]
@@ -66,6 +67,19 @@ class PhasedSkill(Skill):
                 self.on_failure()
                 return Status.FAILURE
             self.motion = self._next()
+
+    def _object(self, name: str) -> TrackedObject:
+        """An object of the robot's belief; a phase failure that says why if there is none."""
+        try:
+            return self.context.world_model.object(name)
+        except KeyError as error:
+            raise PhaseFailure(error.args[0]) from None
+
+    def _surface(self, name: str) -> SupportSurface:
+        try:
+            return self.context.world_model.surface(name)
+        except KeyError as error:
+            raise PhaseFailure(error.args[0]) from None
 
     def on_failure(self) -> None:
         """Called once when a phase's motion fails; leave the robot safe (e.g. open an empty gripper)."""
