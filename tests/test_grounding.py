@@ -1,6 +1,6 @@
 """Grounding phrases to the apartment's objects: a fixed test set, with ambiguity and things that are not there.
 
-The WorldModel here is the one the world declares (five objects: red and blue
+The WorldModel here is told the objects the world declares (red and blue
 cubes and a water bottle on the table, a coffee mug on the counter, a yellow
 ball on the shelf), so the test is about language, not detection.
 """
@@ -11,6 +11,7 @@ import pytest
 from bt_humanoid.perception.grounding import ground
 from bt_humanoid.perception.scene_graph import Relation, scene_graph
 from bt_humanoid.testing.scenario import build_run
+from bt_humanoid.testing.told import tell_object_poses
 
 FOUND = {
     "the red cube": "red cube",
@@ -98,8 +99,9 @@ def test_phrases_naming_nothing_present_are_not_found(phrase, belief):
     assert f"I see nothing that is {phrase!r}" in result.message
 
 
-def _find(phrase: str):
-    run = build_run({"mission": "find it", "tree": {"find": {"object": phrase, "remember_as": "it"}}})
+def _find(phrase: str, robot_start: tuple[float, float, float] | None = None):
+    mission = {"mission": "find it", "tree": {"find": {"object": phrase, "remember_as": "it"}}}
+    run = build_run(mission, robot_start=robot_start)
     return run, run.execute()
 
 
@@ -110,7 +112,7 @@ def test_find_grounds_a_phrase_and_remembers_the_object():
 
 
 def test_find_asks_which_one_when_the_phrase_fits_two():
-    _, result = _find("the cube")
+    _, result = _find("the cube", robot_start=(2.0, 0.0, 0.0))  # west of the table, both cubes in view
     assert result.tree_status == "FAILURE"
     assert "which one do you mean: the red cube or the blue cube?" in result.cause
 
@@ -147,4 +149,6 @@ def test_the_scene_graph_says_what_stands_where():
 
 
 def belief_of_apartment():
-    return build_run({"mission": "words", "tree": {"wait": {"seconds": 0}}}).context.world_model
+    run = build_run({"mission": "words", "tree": {"wait": {"seconds": 0}}})
+    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
+    return run.context.world_model

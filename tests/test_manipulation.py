@@ -76,27 +76,42 @@ def test_held_cube_does_not_slip_while_the_base_drives_and_turns():
     assert slip < 0.005, f"slipped {slip * 1000:.1f} mm"
 
 
-def test_target_moved_during_the_approach_ends_in_a_clear_failure_at_rest():
+def _pick_the_cube_while_it_moves(dx: float, dy: float) -> tuple[Scenario, list[float]]:
+    """Pick the red cube; once the pick has started, the cube is somewhere else (the fault: a person moved it)."""
     mission = {
         "mission": "pick a cube that moves",
         "tree": {"sequence": [*TO_THE_TABLE, {"pick": {"object": "red cube"}}]},
     }
     run = build_run(mission)
     cube = run.sim.model.joint("red_cube").qposadr[0]
-    moved = []
+    moved: list[float] = []
 
-    def push_the_cube_away() -> None:
-        # the fault: once the pick has started, the cube is somewhere else (a person took it)
+    def move_the_cube() -> None:
         if not moved and run.sim.time > 6.5:
-            run.sim.data.qpos[cube + 1] -= 0.3
+            run.sim.data.qpos[cube] += dx
+            run.sim.data.qpos[cube + 1] += dy
             moved.append(run.sim.time)
 
-    run.executor.observers.append(push_the_cube_away)
-    scenario = Scenario(run, run.execute())
+    run.executor.observers.append(move_the_cube)
+    return Scenario(run, run.execute()), moved
+
+
+def test_target_moved_on_the_table_during_the_approach_is_found_again_and_picked():
+    scenario, moved = _pick_the_cube_while_it_moves(-0.1, -0.1)  # 14 cm, still within reach
+    assert moved, "the fault was never injected"
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    noticed = [e for e in scenario.events if e.get("node", "").endswith("stand_near") and e.get("new") == "FAILURE"]
+    assert noticed and "the red cube is no longer where I saw it" in noticed[0]["feedback"]  # then found it again
+    assert scenario.truth.in_hand("red cube") == "right"
+
+
+def test_target_taken_away_during_the_approach_ends_in_a_clear_failure_at_rest():
+    scenario, moved = _pick_the_cube_while_it_moves(20.0, 20.0)  # out of the apartment
     assert moved, "the fault was never injected"
     assert scenario.result.tree_status == "FAILURE"
-    failures = [e for e in scenario.events if e["event"] == "status" and e["new"] == "FAILURE" and "grasp" in e["node"]]
-    assert failures and any("not holding" in e["feedback"] or "nothing" in e["feedback"] for e in failures)
+    assert "I do not know where the red cube is now; looked around here and in every place I know" in (
+        scenario.result.cause
+    )
     assert scenario.final_speed() < 0.01  # never left stuck RUNNING or moving
     assert scenario.truth.in_hand("red cube") is None
 
@@ -113,14 +128,6 @@ def test_fetch_carries_the_mug_from_the_counter_to_the_shelf():
     assert np.hypot(x - 1.2, y - 4.2) < 0.03
     assert scenario.truth.rests_on("coffee mug", "shelf")
     assert scenario.truth.upright("coffee mug")
-
-
-def test_find_fails_clearly_when_the_object_is_no_longer_where_it_was_believed():
-    run = build_run({"mission": "find a lost cube", "tree": {"find": {"object": "red cube"}}})
-    run.context.world_model.object("red cube").confidence = 0.0  # as after a slip: whereabouts unknown
-    scenario = Scenario(run, run.execute())
-    assert scenario.result.tree_status == "FAILURE"
-    assert "recall: I do not know where the red cube is now" in scenario.feedback("find")
 
 
 def _give(release_after: float | None, timeout: float) -> tuple[Scenario, list[float]]:

@@ -6,6 +6,7 @@ from bt_humanoid.benchmarks.manipulation import OBJECTS, SURFACE, run_trial, sam
 from bt_humanoid.control.stance import stance_for
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
+from bt_humanoid.testing.told import told_objects
 
 
 def _table():
@@ -16,7 +17,7 @@ def _table():
 def test_place_object_moves_the_declared_and_the_simulated_pose_together():
     run, table = _table()
     place_object(run, "water bottle", 3.6, -0.2, 0.7)
-    belief = run.context.world_model.object("water bottle")
+    belief = next(o for o in told_objects(run.context.world, run.sim.model) if o.name == "water bottle")
     truth = run.truth.object_position("water bottle")
     assert np.allclose(belief.position[:2], [3.6, -0.2]) and np.allclose(truth[:2], [3.6, -0.2], atol=1e-6)
     assert abs(belief.bottom - table.height) < 0.002

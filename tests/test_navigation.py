@@ -44,7 +44,9 @@ def test_routes_go_around_the_furniture_with_room_to_spare(idle_run, start, goal
     free = navigator.grid.clearance_at(route.points)
     assert free.min() >= navigator.clearance.minimum
     middle = np.minimum(*(np.hypot(*(route.points - np.array(end[:2])).T) for end in (start, goal))) > 0.6
-    assert free[middle].min() >= navigator.clearance.preferred
+    # the planner checks segments every 2.5 cm on a 5 cm grid: a route point between two checks may clip the
+    # corner of a neighbouring cell, up to half a cell nearer an obstacle
+    assert free[middle].min() >= navigator.clearance.preferred - navigator.grid.resolution / 2
 
 
 def test_a_goal_inside_an_obstacle_is_refused_with_its_position(idle_run):

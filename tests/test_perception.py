@@ -66,7 +66,7 @@ def test_colour_names(rgb, name):
 
 
 def _camera_run(robot_start, tree=None):
-    mission = {"mission": "perceive", "perception": "camera", "tree": tree or {"wait": {"seconds": 0}}}
+    mission = {"mission": "perceive", "tree": tree or {"wait": {"seconds": 0}}}
     return build_run(mission, robot_start=robot_start)
 
 

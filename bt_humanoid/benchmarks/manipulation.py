@@ -26,10 +26,11 @@ import numpy as np
 
 from bt_humanoid.benchmarks.common import percentile, pin_to_one_core, save_figures
 from bt_humanoid.control.stance import MAX_DEPTH, stance_for
-from bt_humanoid.perception.declared import declared_world_model
+from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
+from bt_humanoid.testing.told import tell_object_poses
 
 OBJECTS = {"cube": "red cube", "bottle": "water bottle", "mug": "coffee mug"}
 SURFACE = "table"
@@ -106,13 +107,12 @@ def sample_trial(kind: str, surface: SupportSurface, bounds: np.ndarray, footpri
         )
 
 
-def run_trial(trial: Trial, perception: str = "declared") -> Outcome:
+def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
     name = OBJECTS[trial.kind]
     mission = {
         "mission": f"benchmark: pick and place the {name}",
         "world": "apartment",
         "robot": "wheeled_humanoid",
-        "perception": perception,
         "tree": {
             "sequence": [
                 {"pick": {"object": name, "side": SIDE}},
@@ -122,12 +122,14 @@ def run_trial(trial: Trial, perception: str = "declared") -> Outcome:
     }
     run = build_run(mission, robot_start=trial.start)
     parking = iter(PARKING)
-    belief = declared_world_model(run.context.world, run.sim.model)  # set-up: where the world file puts things
+    surfaces = map_world_model(run.context.world, run.sim.model)
     for other in list(run.context.world.objects):
-        surface = belief.surface_under(belief.object(other).position)
+        surface = surfaces.surface_under(run.truth.object_centre(other))
         if other != name and surface is not None and surface.name == SURFACE:
             place_object(run, other, *next(parking), 0.0)
     place_object(run, name, *trial.spot, trial.yaw)
+    if perception == "told":  # control alone: the robot is told where everything is (the camera still looks)
+        tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
     grasped: list[bool] = []
 
     def on_event(event: dict) -> None:
@@ -188,9 +190,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="random seed of the scenes (default 0)")
     parser.add_argument(
         "--perception",
-        choices=["declared", "camera"],
-        default="declared",
-        help="objects known from the world file, or only once the head camera has seen them",
+        choices=["camera", "told"],
+        default="camera",
+        help="objects known only once the head camera has seen them (default), or told where they are",
     )
     parser.add_argument("--json", type=Path, help="also write the figures here")
     args = parser.parse_args(argv)

@@ -34,6 +34,7 @@ HAND_TURN_RATE = 1.2  # rad/s of hand orientation change
 POSITION_TOLERANCE = 0.012  # m: measured hand within this of the target counts as arrived
 ORIENTATION_TOLERANCE = 0.12  # rad
 GAZE_TOLERANCE = 0.03  # rad between the optical axis and the direction to a look_at point
+IN_VIEW = 0.35  # rad off the optical axis within which a point the head cannot centre (at a limit) is still seen
 SETTLE_TIMEOUT = 1.5  # s after the trajectory ends before an unfinished reach fails
 HAND_TORSO_MARGIN = 0.2  # m from the torso's vertical axis that the hands keep out of
 ELBOW_TORSO_MARGIN = 0.25  # m for the elbows: keeps the upper arms off the chest
@@ -272,7 +273,11 @@ class WholeBodyController:
             goal.position_error = float(np.linalg.norm(error[:3]))
             arrived = goal.position_error <= goal.tolerance[0] and np.linalg.norm(error[3:]) <= goal.tolerance[1]
         else:  # look_at: only the gaze
-            arrived = float(np.linalg.norm(goal.gaze_task.error(self.measured))) < GAZE_TOLERANCE
+            off = goal.gaze_task.off_axis(self.measured)
+            arrived = off < GAZE_TOLERANCE
+            if not arrived and off < IN_VIEW and elapsed > goal.duration + SETTLE_TIMEOUT:
+                self._finish(goal, True, f"in view {np.degrees(off):.0f}° off centre (the head is at a limit)")
+                return
         miss = goal.position_error
         if arrived:
             self._finish(goal, True, "arrived" if miss is None else f"arrived within {miss * 100:.1f} cm")

@@ -18,7 +18,7 @@ from bt_humanoid.mission.compiler import CompiledMission, Compiler
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.mission.success import ConditionResult, check_condition
 from bt_humanoid.navigation.navigator import Navigator
-from bt_humanoid.perception.declared import declared_world_model
+from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import Perceiver
 from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
@@ -106,7 +106,7 @@ class MissionRun:
             navigator=self.navigator,
         )
         self.perceiver: Perceiver | None = None
-        if header.perception == "camera":
+        if robot_config.cameras:  # objects are known only once the head camera has seen them
             camera = next(iter(robot_config.cameras))
             self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, "base")
             self.robot.planners.append(self.perceiver)
@@ -128,12 +128,8 @@ class MissionRun:
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
 
     def initial_world_model(self) -> WorldModel:
-        """What the robot knows at the start: the objects the world declares, or (with the camera) none yet."""
-        known = self.spec.known
-        belief = declared_world_model(known.world, self.sim.model)
-        if self.spec.header.perception == "camera":
-            belief.objects.clear()  # surfaces and people are map knowledge; objects must be seen
-        return belief
+        """What the robot knows at the start: its map (surfaces, people, names of things) and no objects yet."""
+        return map_world_model(self.spec.known.world, self.sim.model)
 
     def request_stop(self, reason: str = "stop requested") -> None:
         self.stop_monitor.request(reason)

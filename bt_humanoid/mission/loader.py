@@ -56,7 +56,8 @@ def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: 
     try:
         return model.model_validate(concrete)
     except ValidationError as error:
-        remaining = [e for e in error.errors() if not (e["loc"] and e["loc"][0] in references)]
+        # a field given by reference, and checks across fields (no location) while one is, wait for the leaf to start
+        remaining = [e for e in error.errors() if not (e["loc"][0] in references if e["loc"] else references)]
         if not remaining:
             return model.model_construct(**concrete)
         first_only = ValidationError.from_exception_data(error.title, [remaining[0]])  # type: ignore[list-item]

@@ -88,10 +88,6 @@ class MissionHeader(StrictModel):
     safety: SafetySection = SafetySection()
     recovery: RecoverySection = RecoverySection()
     blackboard: dict[str, Any] = Field(default_factory=dict, description="initial blackboard values")
-    perception: Literal["declared", "camera"] = Field(
-        "declared",
-        description="where the robot's knowledge of objects comes from: the world file's declarations, or the camera",
-    )
     success: list[SuccessCondition] = Field(default_factory=list, description="checked in ground truth at the end")
 
 

@@ -9,9 +9,9 @@ Classical and explainable:
 3. each region's points give its size and pose: the top few centimetres
    outline its footprint (square: a box; round: a cylinder, a mug or a ball),
    the highest point its height;
-4. shape decides the kind (a flat round top with a handle sticking out is a
-   mug, a tall round one a bottle, a rounded top a ball), the median colour
-   of its pixels its colour name.
+4. shape decides the kind (a sphere fitted to the points that rests on the
+   surface is a ball, a flat round top with a handle sticking out a mug, a
+   tall round one a bottle), the median colour of its pixels its colour name.
 """
 
 from __future__ import annotations
@@ -38,9 +38,10 @@ MUG_PROPORTION = 1.4  # height / diameter below which a round thing without a vi
 MIN_MUG_HEIGHT = 0.065  # m: a common-sense prior, cups and mugs are taller than this
 SQUARE = 0.87  # share of its bounding rectangle a flat top fills, above which it is a box's (a disc fills π/4)
 TALL = 2.0  # height / width above which a thing is a bottle
-BALL_TAPER = 0.8  # a ball is much narrower near its top than at its middle...
-BALL_FLATNESS = 0.17  # ...and has little flat top
+SPHERE_FIT = 0.03  # RMS distance from a fitted sphere, relative to its radius, within which the points are a ball's
+RESTS = 0.15  # relative error allowed in a ball's resting pose: centre one radius above the surface, top two
 BOX_FLATNESS = 0.3  # share of a thing's visible points on its flat top above which it is a box (a lid faces up)
+HANDLE_POINTS = 5  # points sticking out of a round body below its rim, from which it has a handle
 WELL_SEEN_TOP = 40  # points on a flat top from which its outline tells a square from a disc
 
 
@@ -124,34 +125,30 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     flat_top = points[heights > top - FLAT_BAND][:, :2]
     if len(band) < 5:
         return None
-    # shape cues that one oblique view gives reliably: the silhouette's width across the line of sight (at the
-    # middle and near the top), how much of the object is its flat top, and how full that top's outline is
-    across = _across(points[:, :2], eye)
-    width = _extent(points[:, :2], across)
-    middle = _extent(points[(heights > 0.3 * top) & (heights < 0.7 * top)][:, :2], across)
-    near_top = _extent(points[heights > 0.85 * top][:, :2], across)
+    # shape cues that one oblique view gives reliably: the silhouette's width across the line of sight, how much
+    # of the object is its flat top and how full that top's outline is, and how well a sphere fits the points
+    width = _extent(points[:, :2], _across(points[:, :2], eye))
     flatness = float(np.mean(heights > top - FLAT_BAND))
-    tapering = near_top / max(middle, 1e-6)
-    centre, diameter, handle = _cylinder(band)
+    centre, diameter, handle = _cylinder(band, lid=heights[heights > top - TOP_BAND] > top - FLAT_BAND)
     yaw_known = True
     if width < MIN_WIDTH:
         return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
-    if top > TALL * width:
+    ball = _resting_sphere(points, surface.height, top)
+    if ball is not None:  # first: a ball half hidden looks narrow and tall
+        kind = "ball"
+        centre, diameter = ball[:2], 2.0 * float(ball[2])
+    elif top > TALL * width:
         kind = "bottle"
     elif handle is not None and top >= MIN_MUG_HEIGHT:
         kind = "mug"
-    elif tapering < BALL_TAPER and flatness < BALL_FLATNESS:
-        kind = "ball"
-        centre, diameter = _circle(band)
     elif _boxy(flat_top, flatness, top, width) or top < MIN_MUG_HEIGHT:  # too low for a cup: a small box
         kind = "box"
-    else:
-        kind = "mug" if top < MUG_PROPORTION * diameter else "can"
+    else:  # a cylinder's silhouette is as wide as it is, from any side
+        kind = "mug" if top < MUG_PROPORTION * max(diameter, width) else "can"
     if kind == "box":
         (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
         narrow, long = sorted((side_a, side_b))
-        # one view foreshortens a side: a cube is as tall as it is long, give or take what a view hides
-        kind = "cube" if long < 1.6 * narrow and abs(top - long) < 0.4 * long else "box"
+        kind = "cube" if _cube(narrow, max(long, width), top, len(flat_top)) else "box"
         centre, size = np.array([cx, cy]), np.array([long, narrow, top])
         yaw = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
     else:
@@ -168,11 +165,38 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     return Detection(kind, colour, position, size, yaw, surface.name, len(points), yaw_known)
 
 
+def _resting_sphere(points: np.ndarray, surface_height: float, top: float) -> np.ndarray | None:
+    """Centre (x, y) and radius of a ball the points lie on, if they do and it rests on the surface; else None.
+
+    A least-squares sphere through the points (|p - c|² = r² is linear in c and r² - |c|²); a ball also sits
+    one radius above its surface and reaches two radii high, which a cube's corner or a mug's rim does not.
+    """
+    if len(points) < 10:
+        return None
+    a = np.c_[2.0 * points, np.ones(len(points))]
+    solution, *_ = np.linalg.lstsq(a, (points**2).sum(axis=1), rcond=None)
+    centre = solution[:3]
+    radius = math.sqrt(max(float(solution[3] + centre @ centre), 1e-12))
+    rms = float(np.sqrt(np.mean((np.linalg.norm(points - centre, axis=1) - radius) ** 2)))
+    resting = abs(centre[2] - surface_height - radius) < RESTS * radius and abs(top - 2 * radius) < RESTS * 2 * radius
+    return np.array([centre[0], centre[1], radius]) if rms < SPHERE_FIT * radius and resting else None
+
+
+def _cube(narrow: float, long: float, top: float, top_points: int) -> bool:
+    """Whether a box is a cube: as tall as it is long, and as deep as it is wide when its lid is seen well.
+
+    From afar the lid is a few pixel rows, so its depth is unknown: then height and width decide.
+    """
+    if abs(top - long) >= 0.4 * long:
+        return False
+    return long < 1.6 * narrow if top_points >= WELL_SEEN_TOP else True
+
+
 def _boxy(flat_top: np.ndarray, flatness: float, top: float, width: float) -> bool:
     """A box's lid rather than a cylinder's disc: by the lid's outline when it is seen well, else by proportions."""
     if len(flat_top) >= WELL_SEEN_TOP:
         return _fill(flat_top) > SQUARE
-    return flatness >= BOX_FLATNESS or (top < 0.8 * width and flatness >= 0.22) or _fill(flat_top) > SQUARE
+    return flatness >= BOX_FLATNESS or (top < 0.8 * width and flatness >= 0.22)
 
 
 def _across(xy: np.ndarray, eye: np.ndarray) -> np.ndarray:
@@ -206,8 +230,11 @@ def _circle(xy: np.ndarray) -> tuple[np.ndarray, float]:
     return np.array([cx, cy]), 2.0 * radius
 
 
-def _cylinder(xy: np.ndarray) -> tuple[np.ndarray, float, np.ndarray | None]:
-    """Body centre and diameter of a round footprint, and the direction of a handle sticking out of it (if any)."""
+def _cylinder(xy: np.ndarray, lid: np.ndarray) -> tuple[np.ndarray, float, np.ndarray | None]:
+    """Body centre and diameter of a round footprint, and the direction of a handle sticking out of it (if any).
+
+    ``lid`` marks the points on the flat top: part of the body, never of a handle, which stays below the rim.
+    """
     centre, _ = _circle(xy)
     offsets = xy - centre
     distance = np.hypot(*offsets.T)
@@ -216,8 +243,8 @@ def _cylinder(xy: np.ndarray) -> tuple[np.ndarray, float, np.ndarray | None]:
     body_centre, body_diameter = _circle(xy[body])
     offsets = xy - body_centre
     distance = np.hypot(*offsets.T)
-    outside = distance > body_diameter / 2 + 0.008
-    if outside.sum() >= max(3, 0.04 * len(xy)):
+    outside = (distance > body_diameter / 2 + 0.008) & ~lid
+    if outside.sum() >= max(HANDLE_POINTS, 0.04 * len(xy)):
         direction = offsets[outside].mean(axis=0)
         return body_centre, body_diameter, direction / max(float(np.hypot(*direction)), 1e-9)
     return body_centre, body_diameter, None

@@ -67,6 +67,17 @@ OPEN_WORDS_GAP = 0.12  # ...or by which the best must stand out from the mean of
 OPEN_WORDS_MARGIN = 0.2  # embeddings are vaguer than attributes: a wider margin before choosing without asking
 
 
+def describes_an_object(phrase: str, names: list[str]) -> bool:
+    """Whether ``phrase`` reads as a description grounding can work with, not a misspelt name.
+
+    It must use a word grounding knows: a colour, a kind, a size, a word of one of ``names`` (the world's
+    objects and surfaces), or an open "something ...".
+    """
+    known = COLOURS | set(KIND_WORDS) | BIG | SMALL | {"something", "thing", "object"}
+    known |= {word for name in names for word in name.lower().split()}
+    return any(word in known for word in re.findall(r"[a-z]+", phrase.lower()))
+
+
 @dataclass
 class Candidate:
     object: TrackedObject
@@ -167,6 +178,26 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
         result.verdict = "found"
         result.message = f"the {ranked[0].object.name}"
     return result
+
+
+def resolve(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None) -> TrackedObject:
+    """The one object ``phrase`` means: an id, a name, a name the world gives (``WorldModel.object``), or a phrase.
+
+    Raises KeyError with a sentence for people: not seen yet, believed gone, which one do you mean, not here.
+    """
+    try:
+        return belief.object(phrase)
+    except KeyError:
+        if (
+            phrase in belief.objects
+            or phrase in belief.vocabulary
+            or any(o.name == phrase for o in belief.objects.values())
+        ):
+            raise  # a name it knows: the error says what is wrong with it
+    grounding = ground(phrase, belief, viewer)
+    if grounding.verdict != "found" or grounding.best is None:
+        raise KeyError(grounding.message)  # which one do you mean / I see nothing that is …
+    return grounding.best
 
 
 def _not_found(phrase: str, present: list[TrackedObject]) -> Grounding:

@@ -1,10 +1,10 @@
 """The WorldModel: what the robot believes about objects and support surfaces.
 
 Skills and planners read objects and surfaces from here, never from the
-simulator. Beliefs are filled by a source (``declared.py`` seeds them from
-the world's declarations until RGB-D perception takes over) and by the
-robot's own actions: an object it holds moves with its hand, an object it
-put down is where it let go.
+simulator. The map gives surfaces, people and the names of things
+(``map_knowledge.py``); the head camera finds objects (``perceiver.py``);
+and the robot's own actions move beliefs: an object it holds moves with its
+hand, an object it put down is where it let go.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.whole_body import yaw_rotation
 from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.manipulation_skills import CARRY_TOLERANCE, Side, _ManipulationSkill
-from bt_humanoid.skills.params import check_name
+from bt_humanoid.skills.params import check_name, check_object
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel, exactly_one
@@ -37,7 +37,7 @@ class LookAt(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: LookAtParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.object, context.world.objects, "object", "object")
+        return check_object(params.object, context.world)
 
     def phases(self):
         return [("look", self._look)]

@@ -21,7 +21,7 @@ from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Lim
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.skills.context import CheckContext
-from bt_humanoid.skills.params import check_name
+from bt_humanoid.skills.params import check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel, exactly_one
@@ -103,9 +103,7 @@ class StandNear(_ManipulationSkill):
     @classmethod
     def check(cls, params: StandNearParams, context: CheckContext) -> list[tuple[str, str]]:
         world = context.world
-        return check_name(params.object, world.objects, "object", "object") + check_name(
-            params.surface, world.surfaces, "surface", "surface"
-        )
+        return check_object(params.object, world) + check_name(params.surface, world.surfaces, "surface", "surface")
 
     def phases(self):
         return [
@@ -173,7 +171,7 @@ class Grasp(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: GraspParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.object, context.world.objects, "object", "object")
+        return check_object(params.object, context.world)
 
     def phases(self):
         return [

@@ -17,7 +17,7 @@ from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE
-from bt_humanoid.skills.params import check_name
+from bt_humanoid.skills.params import check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel, exactly_one
@@ -63,9 +63,7 @@ def tuck_empty_arms(context: SkillContext) -> MotionHandle | None:
 
 def _places_and_objects(params: NavigateToParams | TurnParams, context: CheckContext) -> list[tuple[str, str]]:
     """The named place and object of a base skill's parameters exist in the world."""
-    return check_name(params.place, context.world.places, "place", "place") + check_name(
-        params.object, context.world.objects, "object", "object"
-    )
+    return check_name(params.place, context.world.places, "place", "place") + check_object(params.object, context.world)
 
 
 class NavigateToParams(StrictModel):

@@ -6,6 +6,8 @@ from collections.abc import Iterable
 from typing import Any
 
 from bt_humanoid.errors import did_you_mean
+from bt_humanoid.perception.grounding import describes_an_object
+from bt_humanoid.sim.world_config import WorldConfig
 
 
 def is_reference(value: Any) -> bool:
@@ -34,3 +36,12 @@ def check_name(value: str | None, valid: Iterable[str], parameter: str, what: st
     if value is None or value in valid:
         return []
     return [(parameter, f"unknown {what} '{value}' ({did_you_mean(value, valid)})")]
+
+
+def check_object(value: str | None, world: WorldConfig, parameter: str = "object") -> list[tuple[str, str]]:
+    """Compile-time check of an object parameter: a name the world gives, or a phrase to ground when it runs."""
+    names = list(world.objects)
+    if value is None or value in names or describes_an_object(value, [*names, *world.surfaces]):
+        return []
+    example = 'or a description such as "the red cube" or "the cup on the counter"'
+    return [(parameter, f"unknown object '{value}' ({did_you_mean(value, names)}), {example}")]

@@ -17,7 +17,7 @@ import numpy as np
 from pydantic import Field
 
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.perception.grounding import ground
+from bt_humanoid.perception.grounding import resolve
 from bt_humanoid.skills.manipulation_skills import _ManipulationSkill
 from bt_humanoid.skills.navigation_skills import tuck_empty_arms
 from bt_humanoid.skills.phased import PhaseFailure
@@ -73,18 +73,11 @@ class Find(_ManipulationSkill):
             raise PhaseFailure(self.reason)  # no camera to look around with
 
     def _known(self):
-        belief, phrase = self.context.world_model, self.params.object
         try:
-            target = belief.object(phrase)
+            target = resolve(self.params.object, self.context.world_model, viewer=self.context.robot.base.pose())
         except KeyError as error:
             self.reason = error.args[0]
-            if phrase in belief.vocabulary or any(o.name == phrase for o in belief.objects.values()):
-                return None  # a name it knows: the reason says what is wrong with it
-            grounding = ground(phrase, belief, viewer=self.context.robot.base.pose())
-            if grounding.verdict != "found":
-                self.reason = grounding.message  # which one do you mean / I see nothing that is …
-                return None
-            target = grounding.best
+            return None
         if target.held_by is None and self.context.world_model.surface_under(target.position) is None:
             self.reason = f"the {target.name} is not on any surface I know"
             return None
@@ -106,6 +99,13 @@ class Find(_ManipulationSkill):
             where = "here and in every place I know" if self.params.search and self.context.navigator else "from here"
             raise PhaseFailure(f"{self.reason}; looked around {where}")
         self.context.blackboard.set(self.params.remember_as, self.target.id)
-        if self.target.held_by is not None:
-            return None  # in hand: found
+        if self.target.held_by is not None or not self._within_head_turn(self.target.position):
+            return None  # in hand, or behind the robot (remembered from an earlier look): found all the same
         return self.context.robot.whole_body.look_at(self.target.position)
+
+    def _within_head_turn(self, point: np.ndarray) -> bool:
+        x, y, yaw = self.context.robot.base.pose()
+        bearing = math.remainder(math.atan2(point[1] - y, point[0] - x) - yaw, math.tau)
+        pan = self.context.robot_config.head_pan
+        low, high = self.context.joint_ranges[pan] if pan else (0.0, 0.0)
+        return low <= bearing <= high

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from py_trees.common import Status
 
 from bt_humanoid.control.motion import MotionHandle, MotionStatus
+from bt_humanoid.perception.grounding import resolve
 from bt_humanoid.perception.world_model import SupportSurface, TrackedObject
 from bt_humanoid.skills.base import Skill
 
@@ -68,12 +69,18 @@ class PhasedSkill(Skill):
                 return Status.FAILURE
             self.motion = self._next()
 
-    def _object(self, name: str) -> TrackedObject:
-        """An object of the robot's belief; a phase failure that says why if there is none."""
+    def _object(self, phrase: str) -> TrackedObject:
+        """The object a name, an id or a phrase means in the robot's belief; a phase failure that says why if none.
+
+        An object looked for where it was believed to be, and not seen there, is gone: acting on it would grasp air.
+        """
         try:
-            return self.context.world_model.object(name)
+            target = resolve(phrase, self.context.world_model, viewer=self.context.robot.base.pose())
         except KeyError as error:
             raise PhaseFailure(error.args[0]) from None
+        if target.confidence <= 0.0 and target.held_by is None:
+            raise PhaseFailure(f"the {target.name} is no longer where I saw it")
+        return target
 
     def _surface(self, name: str) -> SupportSurface:
         try:

@@ -1,8 +1,9 @@
 """Scene set-up for tests and benchmarks: put an object somewhere before a run starts.
 
 Set-up is the one place where positions are written: the object's declared
-pose (what the robot is told, and so its WorldModel) and its simulated pose
-change together, before the first step. Never call this during a run.
+pose and its simulated pose change together, before the first step, so a
+benchmark that tells the robot where things are (``told.py``) tells it the
+new pose. Never call this during a run.
 """
 
 from __future__ import annotations
@@ -13,22 +14,22 @@ import mujoco
 import numpy as np
 
 from bt_humanoid.engine.runner import MissionRun
-from bt_humanoid.perception.declared import declared_world_model
+from bt_humanoid.perception.map_knowledge import map_world_model
+from bt_humanoid.testing.told import told_objects
 
 DROP = 0.001  # m above the surface the object starts, so it settles without a jolt
 
 
 def place_object(run: MissionRun, name: str, x: float, y: float, yaw: float) -> None:
-    """Stand object ``name`` upright at (x, y) on the surface there, turned ``yaw`` rad; re-seed the WorldModel."""
+    """Stand object ``name`` upright at (x, y) on the surface there, turned ``yaw`` rad."""
     if run.sim.time > 0.0:
         raise RuntimeError("place_object is set-up: call it before the run starts")
-    declared = declared_world_model(run.context.world, run.sim.model)
-    surface = declared.surface_under(np.array([x, y, 10.0]))
+    surface = map_world_model(run.context.world, run.sim.model).surface_under(np.array([x, y, 10.0]))
     if surface is None:
         raise ValueError(f"({x:.2f}, {y:.2f}) is on no known surface")
     model, data = run.sim.model, run.sim.data
     body = model.body(run.context.world.objects[name].body)
-    obj = declared.object(name)
+    obj = next(o for o in told_objects(run.context.world, model) if o.name == name)
     bottom_in_body = obj.position[2] - obj.size[2] / 2 - body.pos[2]  # for an upright body
     position = np.array([x, y, surface.height - bottom_in_body + DROP])
     quat = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
@@ -38,4 +39,3 @@ def place_object(run: MissionRun, name: str, x: float, y: float, yaw: float) -> 
     for qpos in (data.qpos, model.qpos0):
         qpos[address : address + 7] = np.concatenate([position, quat])
     mujoco.mj_forward(model, data)
-    run.context.world_model = run.initial_world_model()  # told where it is now, unless the camera must find it

@@ -30,6 +30,11 @@ class GazeTask(Task):
         axis, direction = self._axes(kinematics)
         return np.cross(axis, direction)
 
+    def off_axis(self, kinematics: RobotKinematics) -> float:
+        """Angle (rad) between the optical axis and the direction to the target: 0 centred, π behind."""
+        axis, direction = self._axes(kinematics)
+        return float(np.arctan2(np.linalg.norm(np.cross(axis, direction)), axis @ direction))
+
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
         axis, _ = self._axes(kinematics)
         across = np.eye(3) - np.outer(axis, axis)
