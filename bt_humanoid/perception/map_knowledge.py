@@ -1,4 +1,4 @@
-"""What the robot knows from its map before it looks: support surfaces, people and the names of things.
+"""What the robot knows from its map before it looks: surfaces, rooms, people and the names of things.
 
 Surfaces (table, counter, shelf) are fixed furniture, the map's business;
 people are where the world puts them; the vocabulary says what people call
@@ -17,7 +17,7 @@ from bt_humanoid.sim.world_config import WorldConfig
 
 
 def map_world_model(world: WorldConfig, model: mujoco.MjModel) -> WorldModel:
-    """A WorldModel with the map's surfaces, people and vocabulary, and no objects yet."""
+    """A WorldModel with the map's surfaces, rooms, people and vocabulary, and no objects yet."""
     belief = WorldModel()
     for name, surface in world.surfaces.items():
         geom = model.geom(surface.geom)
@@ -27,6 +27,9 @@ def map_world_model(world: WorldConfig, model: mujoco.MjModel) -> WorldModel:
         belief.surfaces[name] = SupportSurface(
             name, np.array([centre[:2] - half[:2], centre[:2] + half[:2]]), float(centre[2] + half[2])
         )
+    for name, place in world.places.items():
+        if place.kind == "room" and place.region is not None:
+            belief.rooms[name] = np.array(place.region, dtype=float)
     for name, person in world.people.items():
         for alias in (name, *person.aliases):
             belief.people[alias] = model.body(person.body).pos.copy()

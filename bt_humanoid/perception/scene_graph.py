@@ -1,4 +1,4 @@
-"""Relations between what the robot believes is there: on, near, left of, right of.
+"""Relations between what the robot believes is there: on, in (a room), near, left of, right of.
 
 A scene graph is a list of (subject, relation, object) facts computed from
 the WorldModel on demand. "Left" and "right" are as seen from a viewer (the
@@ -21,8 +21,8 @@ SIDE = 0.02  # m sideways (across the line of sight) before one thing is left or
 @dataclass(frozen=True)
 class Relation:
     subject: str  # object id
-    relation: str  # on, near, left_of, right_of
-    object: str  # object id or surface name
+    relation: str  # on, in, near, left_of, right_of
+    object: str  # object id, surface name or room name
 
 
 def scene_graph(belief: WorldModel, viewer: np.ndarray | None = None) -> list[Relation]:
@@ -33,6 +33,9 @@ def scene_graph(belief: WorldModel, viewer: np.ndarray | None = None) -> list[Re
         surface = belief.surface_under(a.position)
         if surface is not None:
             facts.append(Relation(a.id, "on", surface.name))
+        room = belief.room_of(a.position)
+        if room is not None:
+            facts.append(Relation(a.id, "in", room))
         for b in present:
             if a is not b:
                 facts += [Relation(a.id, r, b.id) for r in pairwise(a, b, viewer)]

@@ -66,6 +66,7 @@ class WorldModel:
     objects: dict[str, TrackedObject] = field(default_factory=dict)
     surfaces: dict[str, SupportSurface] = field(default_factory=dict)
     people: dict[str, np.ndarray] = field(default_factory=dict)  # name or alias → position (m)
+    rooms: dict[str, np.ndarray] = field(default_factory=dict)  # name → [[x_min, y_min], [x_max, y_max]] (m)
     vocabulary: dict[str, tuple[str, str]] = field(default_factory=dict)  # what people call things → (kind, colour)
 
     def object(self, name: str) -> TrackedObject:
@@ -102,6 +103,11 @@ class WorldModel:
         if name not in self.people:
             raise KeyError(f"no person {name!r}; {did_you_mean(name, list(self.people))}")
         return self.people[name]
+
+    def room_of(self, position: np.ndarray) -> str | None:
+        """The room whose region holds ``position``, if any."""
+        xy = np.asarray(position[:2])
+        return next((name for name, r in self.rooms.items() if np.all(xy >= r[0]) and np.all(xy <= r[1])), None)
 
     def surface_under(self, position: np.ndarray) -> SupportSurface | None:
         """The highest surface below ``position`` whose rectangle contains it."""
