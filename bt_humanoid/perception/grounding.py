@@ -90,6 +90,7 @@ class Grounding:
     candidates: list[Candidate] = field(default_factory=list)  # best first
     verdict: str = "not found"  # found | ambiguous | not found
     message: str = ""
+    tied: list[TrackedObject] = field(default_factory=list)  # when ambiguous: the ones it could not tell apart
 
     @property
     def best(self) -> TrackedObject | None:
@@ -179,9 +180,9 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
     result = Grounding(phrase, ranked)
     margin = OPEN_WORDS_MARGIN if leftover and not attributes else AMBIGUITY_MARGIN
     if len(ranked) > 1 and ranked[0].score - ranked[1].score < margin:
-        tied = [c.object.name for c in ranked if ranked[0].score - c.score < margin]
+        result.tied = [c.object for c in ranked if ranked[0].score - c.score < margin]
         result.verdict = "ambiguous"
-        result.message = f"which one do you mean: the {' or the '.join(tied)}?"
+        result.message = f"which one do you mean: the {' or the '.join(o.name for o in result.tied)}?"
     else:
         result.verdict = "found"
         result.message = f"the {ranked[0].object.name}"

@@ -24,6 +24,7 @@ from bt_humanoid.strict_model import StrictModel, exactly_one
 
 LOOK_AHEAD_POSTURE = "look_ahead"  # robot.yaml posture: head level, camera on the way ahead
 OBJECT_STANDOFF = 0.35  # m between the footprint and an object on the floor
+PERSON_STANDOFF = 0.6  # m between the footprint and a person: arm's length, to hand things over
 STANCE_BACKOFF = 0.35  # m behind the stance for working on an object on a surface
 BACK_UP_SPEED = 0.2  # m/s
 
@@ -62,23 +63,32 @@ def tuck_empty_arms(context: SkillContext) -> MotionHandle | None:
 
 
 def _places_and_objects(params: NavigateToParams | TurnParams, context: CheckContext) -> list[tuple[str, str]]:
-    """The named place and object of a base skill's parameters exist in the world."""
-    return check_name(params.place, context.world.places, "place", "place") + check_object(params.object, context.world)
+    """The named place, object and person of a base skill's parameters exist in the world."""
+    problems = check_name(params.place, context.world.places, "place", "place")
+    problems += check_object(params.object, context.world)
+    if isinstance(params, NavigateToParams):
+        people = [n for name, person in context.world.people.items() for n in (name, *person.aliases)]
+        problems += check_name(params.person, people, "person", "person")
+    return problems
 
 
 class NavigateToParams(StrictModel):
     place: str | None = Field(None, description="a named place of the world")
     object: str | None = Field(None, description="an object: a stand-off pose facing it (from the world model)")
     pose: tuple[float, float, float] | None = Field(None, description="[x, y, yaw_deg] in the world")
+    person: str | None = Field(None, description="a person (name or alias): arm's length from them, facing them")
     max_speed: float | None = Field(None, gt=0, le=2.0, description="m/s cap, below the robot's and mission's limits")
 
     @model_validator(mode="after")
     def _one_goal(self) -> NavigateToParams:
-        exactly_one(self, "place", "object", "pose")
+        exactly_one(self, "place", "object", "pose", "person")
         return self
 
 
-@skill("navigate_to", "plan a route around obstacles to a place, an object or a pose, follow it, replan if blocked")
+@skill(
+    "navigate_to",
+    "plan a route around obstacles to a place, an object, a person or a pose, follow it, replan if blocked",
+)
 class NavigateTo(_BaseSkill):
     Params = NavigateToParams
 
@@ -112,7 +122,23 @@ class NavigateTo(_BaseSkill):
         if p.pose is not None:
             x, y, yaw = p.pose
             return np.array([x, y, math.radians(yaw)]), f"pose ({x:.2f}, {y:.2f}, {yaw:.0f}°)"
+        if p.person is not None:
+            return self._facing(self._person(p.person), PERSON_STANDOFF), f"the {p.person}"
         return self._standoff(p.object), f"the {p.object}"
+
+    def _person(self, name: str) -> np.ndarray:
+        try:
+            return self.context.world_model.person(name)
+        except KeyError as error:
+            raise PhaseFailure(error.args[0]) from None
+
+    def _facing(self, position: np.ndarray, standoff: float) -> np.ndarray:
+        """A pose ``standoff`` from the footprint's edge to ``position``, on the robot's side, facing it."""
+        here = self.context.robot.base.pose()
+        away = here[:2] - position[:2]
+        direction = away / max(float(np.hypot(*away)), 1e-6)
+        xy = position[:2] + (self.context.robot_config.base.footprint_radius + standoff) * direction
+        return np.array([*xy, math.atan2(-direction[1], -direction[0])])
 
     def _standoff(self, name: str) -> np.ndarray:
         """Facing the object: at the nearest edge of the surface it stands on, or beside it on the floor."""
@@ -130,11 +156,7 @@ class NavigateTo(_BaseSkill):
                 raise PhaseFailure(str(error)) from None
             # a step back from the working stance: room to raise the arms before the last approach (stand_near)
             return np.array([x - STANCE_BACKOFF * math.cos(yaw), y - STANCE_BACKOFF * math.sin(yaw), yaw])
-        away = here[:2] - obj.position[:2]
-        distance = config.base.footprint_radius + OBJECT_STANDOFF
-        direction = away / max(float(np.hypot(*away)), 1e-6)
-        xy = obj.position[:2] + distance * direction
-        return np.array([*xy, math.atan2(-direction[1], -direction[0])])
+        return self._facing(obj.position, OBJECT_STANDOFF)
 
 
 class TurnParams(StrictModel):

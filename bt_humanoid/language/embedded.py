@@ -1,0 +1,563 @@
+"""The embedded planner: English commands to missions, offline and deterministic.
+
+A command is split into clauses ("go to the kitchen, pick up the mug and
+bring it to me" has three), and each clause is matched against the phrasings
+of what the robot can do, verb first. Objects are grounded in the robot's
+WorldModel (``perception/grounding.py``): a phrase that fits two things
+becomes a question, one that fits nothing a refusal. "it" and "them" are the
+objects of an earlier clause. The result is a mission in the mission
+language, made of the library's behaviours:
+
+=========================  ======================================================
+"pick up the red cube"     take (find it, go to it, pick it up)
+"put the mug on the shelf" fetch (take it, carry it, place it on a free spot)
+"bring me the bottle"      take, navigate to the person, give
+"go to the kitchen"        navigate
+"walk forward 2 meters"    move_base, relative
+"turn left 90 degrees"     move_base, relative yaw
+"find the ball"            find, then say where it is
+"wave", "say hello"        wave, say
+"stop"                     a stop, not a mission
+=========================  ======================================================
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from bt_humanoid.language.plan import Choice, Plan, PlanningContext
+from bt_humanoid.language.words import normalise
+from bt_humanoid.perception.free_space import free_spot
+from bt_humanoid.perception.grounding import KIND_WORDS, describes_an_object, ground
+from bt_humanoid.perception.world_model import TrackedObject
+
+ABILITIES = (
+    "go to a place, pick things up, put them on the table, the counter or the shelf, bring them to you, "
+    "find them, walk forward or back, turn, wave, say something, and stop"
+)
+DEFAULT_TURN = 90.0  # degrees for "turn left" without a number
+DEFAULT_STEP = 1.0  # m for "walk forward" without a number
+MAX_STEP = 5.0  # m: a longer relative move is a job for "go to"
+PERSON_WORDS = {"me", "us", "the user", "user", "the person", "person", "here"}
+CLAUSE_BREAK = re.compile(r"\s*(?:,\s*)?(?:\band then\b|\bthen\b|\bafter that\b|\band\b|,)\s*")
+ARTICLE = re.compile(r"^(?:the|a|an|some|my|your|that|this)\s+")
+
+VERB = r"(?:pick|grab|take|get|lift|grasp|collect|put|place|set|drop|leave|bring|fetch|hand|give|pass|carry|go|walk|"
+VERB += r"drive|move|head|navigate|come|return|turn|rotate|spin|face|find|look|search|locate|where|show|say|tell|"
+VERB += r"announce|wave|stop|halt|freeze|back|step)\b"
+STARTS_WITH_VERB = re.compile(rf"^{VERB}")
+
+PATTERNS: list[tuple[str, re.Pattern[str]]] = [
+    ("stop", re.compile(r"^(?:stop|halt|freeze|stand still|abort|cancel)\b")),
+    ("say", re.compile(r"^(?:say|tell (?:me|us|them|everyone)|announce)\s+(?P<text>.+)$")),
+    ("wave", re.compile(r"^wave\b(?:.*?\b(?P<times>\d+)\s+times)?")),
+    (
+        "step",
+        re.compile(
+            r"^(?:walk|go|move|drive|step|roll|come|back up|head)\s+(?P<dir>forwards?|ahead|straight|back|backwards?)"
+            r"(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?P<unit>meters?|metres?|m|centimeters?|centimetres?|cm|steps?))?$"
+        ),
+    ),
+    ("back_up", re.compile(r"^back up(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?P<unit>meters?|metres?|m|cm))?$")),
+    (
+        "turn",
+        re.compile(
+            r"^(?:turn|rotate|spin)\s+(?:to (?:the|your)\s+)?(?P<dir>left|right|around)"
+            r"(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?:degrees?|deg))?$"
+        ),
+    ),
+    ("face", re.compile(r"^(?:turn to face|face|turn towards?|look towards?)\s+(?P<where>.+)$")),
+    (
+        "bring_me",
+        re.compile(r"^(?:bring|fetch|get|hand|give|pass)\s+(?:me|us)\s+(?P<what>.+)$"),
+    ),
+    (
+        "bring_to",
+        re.compile(
+            r"^(?:bring|fetch|get|hand|give|pass|take|carry|move)\s+(?P<what>.+?)\s+"
+            r"(?:over\s+)?(?:to|onto|over to|into|back to)\s+(?P<where>.+)$"  # "on the table" says where it is
+        ),
+    ),
+    ("bring_here", re.compile(r"^(?:bring|fetch)\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
+    (
+        "put",
+        re.compile(
+            r"^(?:put|place|set|drop|leave|stack)\s+(?:down\s+)?(?P<what>.+?)\s+(?:down\s+)?"
+            r"(?:on top of|onto|on|into|in)\s+(?P<where>.+)$"
+        ),
+    ),
+    ("put_down", re.compile(r"^(?:put|place|set|drop)\s+(?:down\s+)?(?P<what>.+?)(?:\s+down)?$")),
+    ("come", re.compile(r"^(?:come|come here|come over here|come back|come to me|return to me)$")),
+    (
+        "go",
+        re.compile(
+            r"^(?:go|walk|drive|move|head|navigate|come|return|get)\s+(?:back\s+)?(?:over\s+)?"
+            r"(?:to|into|in|towards?|inside)\s+(?P<where>.+)$"
+        ),
+    ),
+    ("go_home", re.compile(r"^(?:go|come|return)\s+(?:back\s+)?home$")),
+    (
+        "find",
+        re.compile(
+            r"^(?:find|look for|search for|locate|where is|where's|where are|look at|show me|can you see|do you see)"
+            r"\s+(?P<what>.+?)$"
+        ),
+    ),
+    (
+        "pick",
+        re.compile(r"^(?:pick up|pick|grab|take|get|lift|grasp|collect|hold)\s+(?P<what>.+?)(?:\s+up)?$"),
+    ),
+]
+
+
+class PlanRefused(Exception):
+    """A clause the robot cannot do: the message says why, and what it can do instead."""
+
+
+class Question(Exception):
+    def __init__(self, choice: Choice, text: str) -> None:
+        super().__init__(text)
+        self.choice = choice
+
+
+@dataclass
+class _State:
+    """What the plan so far implies: what the robot will hold, what "it" means, spots already promised."""
+
+    held: str | None = None
+    last: list[str] = field(default_factory=list)
+    spots: list[np.ndarray] = field(default_factory=list)
+    steps: list[dict[str, Any]] = field(default_factory=list)
+    lines: list[str] = field(default_factory=list)
+
+
+class EmbeddedPlanner:
+    """Commands to missions by phrasing rules and grounding; asks when a phrase fits two things."""
+
+    name = "embedded"
+
+    def plan(self, text: str, context: PlanningContext) -> Plan:
+        started = time.perf_counter()
+        command = normalise(text)
+        if not command:
+            return Plan("refusal", "I did not hear a command.")
+        state = _State()
+        try:
+            for clause in split_clauses(command):
+                kind = self._clause(clause, state, context)
+                if kind == "stop":
+                    return Plan("stop", "Stopping.")
+        except Question as question:
+            question.choice.command = text
+            return Plan("question", str(question), choice=question.choice, planning_time=time.perf_counter() - started)
+        except PlanRefused as refusal:
+            return Plan("refusal", str(refusal), planning_time=time.perf_counter() - started)
+        tree = state.steps[0] if len(state.steps) == 1 else {"sequence": state.steps}
+        mission = {
+            "mission": text.strip()[:120] or command,
+            "world": context.world.name,
+            "robot": context.robot,
+            "tree": tree,
+        }
+        summary = "I will " + _join(state.lines) + "."
+        return Plan("mission", summary, mission=mission, steps=state.lines, planning_time=time.perf_counter() - started)
+
+    def answer(self, choice: Choice, reply: str, context: PlanningContext) -> Plan:
+        """Continue a command after a question: the reply picks one of the choice's options."""
+        picked = pick_option(choice, reply, context)
+        if picked is None:
+            options = " or the ".join(choice.options)
+            return Plan("question", f"Sorry, which one: the {options}?", choice=choice)
+        command = normalise(choice.command)
+        return self.plan(_replace_phrase(command, choice.phrase, picked), context)
+
+    # --- clauses -----------------------------------------------------------------
+
+    def _clause(self, clause: str, state: _State, context: PlanningContext) -> str:
+        for kind, pattern in PATTERNS:
+            match = pattern.match(clause)
+            if match is None:
+                continue
+            handler = getattr(self, f"_{kind}")
+            handler(match, state, context)
+            return kind
+        raise PlanRefused(f"I can't {clause}. I can {ABILITIES}.")
+
+    def _stop(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        pass
+
+    def _say(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        text = match["text"].strip().strip("'\"")
+        text = re.sub(r"^(?:that|to)\s+", "", text)
+        state.steps.append({"say": {"text": text[:1].upper() + text[1:]}})
+        state.lines.append(f'say "{text}"')
+
+    def _wave(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        times = int(match["times"]) if match["times"] else 2
+        if not 1 <= times <= 10:
+            raise PlanRefused(f"I can wave 1 to 10 times, not {times}.")
+        state.steps.append({"wave": {"times": times}})
+        state.lines.append("wave")
+
+    def _step(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        distance = _distance(match["n"], match["unit"])
+        if match["dir"].startswith("back"):
+            distance = -distance
+        _relative_move(state, x=distance)
+
+    def _back_up(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        _relative_move(state, x=-_distance(match["n"], match["unit"], default=0.5))
+
+    def _turn(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        if match["dir"] == "around":
+            angle = float(match["n"]) if match["n"] else 180.0
+        else:
+            angle = float(match["n"]) if match["n"] else DEFAULT_TURN
+            if match["dir"] == "right":
+                angle = -angle
+        if not -360.0 <= angle <= 360.0:
+            raise PlanRefused(f"I turn at most a full circle at a time, not {abs(angle):.0f} degrees.")
+        state.steps.append({"move_base": {"relative": True, "yaw": angle}})
+        state.lines.append(f"turn {'left' if angle > 0 else 'right'} {abs(angle):.0f} degrees")
+
+    def _face(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        where = _bare(match["where"])
+        place = _place_name(where, context)
+        if place is not None:
+            state.steps.append({"turn": {"place": place}})
+            state.lines.append(f"turn to face the {_spoken(place)}")
+            return
+        target = self._one_object(match["where"], state, context)
+        state.steps.append({"turn": {"object": target}})
+        state.lines.append(f"turn to face the {target}")
+
+    def _bring_me(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        for target in self._objects(match["what"], state, context):
+            self._take(target, state)
+            self._give(state, context)
+
+    def _bring_here(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        self._bring_me(match, state, context)
+
+    def _bring_to(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        where = _bare(match["where"])
+        if where in PERSON_WORDS or where in _people(context):
+            self._bring_me(match, state, context)
+            return
+        self._put_on(match["what"], match["where"], state, context)
+
+    def _put(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        self._put_on(match["what"], match["where"], state, context)
+
+    def _put_down(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        surfaces = ", the ".join(context.world.surfaces)
+        raise PlanRefused(f"Where should I put it? Say, for example, 'put it on the {surfaces}'.")
+
+    def _come(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        self._go_to_person(state, context)
+
+    def _go(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        where = _bare(match["where"])
+        if where in PERSON_WORDS or where in _people(context):
+            self._go_to_person(state, context)
+            return
+        place = _place_name(where, context)
+        if place is not None:
+            state.steps.append({"navigate": {"place": place}})
+            state.lines.append(f"go to the {_spoken(place)}")
+            return
+        if describes_an_object(where, list(context.world.objects)):
+            target = self._one_object(match["where"], state, context)
+            key = _key(target)
+            state.steps.append({"find": {"object": target, "remember_as": key}})
+            state.steps.append({"navigate": {"object": f"${key}"}})
+            state.lines.append(f"go to the {target}")
+            return
+        places = ", the ".join(_spoken(p) for p in context.world.places)
+        raise PlanRefused(f"I don't know a place called '{where}'. I know the {places}.")
+
+    def _go_home(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        home = "start" if "start" in context.world.places else next(iter(context.world.places))
+        state.steps.append({"navigate": {"place": home}})
+        state.lines.append(f"go back to the {_spoken(home)}")
+
+    def _find(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        for target in self._objects(match["what"], state, context):
+            state.steps.append({"find": {"object": target, "remember_as": _key(target)}})
+            state.steps.append({"say": {"text": f"I found the {target}."}})
+            state.lines.append(f"find the {target}")
+
+    def _pick(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        targets = self._objects(match["what"], state, context)
+        if len(targets) > 1:
+            raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(targets)}.")
+        self._take(targets[0], state)
+
+    # --- shared steps --------------------------------------------------------------
+
+    def _take(self, target: str, state: _State) -> None:
+        if state.held == target:
+            return  # already in hand from an earlier clause
+        if state.held is not None:
+            raise PlanRefused(f"I will be holding the {state.held}; tell me where to put it before the {target}.")
+        state.steps.append({"take": {"object": target}})
+        state.lines.append(f"pick up the {target}")
+        state.held = target
+
+    def _give(self, state: _State, context: PlanningContext) -> None:
+        person = next(iter(context.world.people), None)
+        if person is None:
+            raise PlanRefused("There is nobody here to give it to.")
+        state.steps.append({"navigate": {"person": person}})
+        state.steps.append({"give": {"to": person}})
+        state.lines.append(f"bring it to you and hand over the {state.held}")
+        state.held = None
+
+    def _go_to_person(self, state: _State, context: PlanningContext) -> None:
+        person = next(iter(context.world.people), None)
+        if person is None:
+            raise PlanRefused("I don't know where you are.")
+        state.steps.append({"navigate": {"person": person}})
+        state.lines.append("come to you")
+
+    def _put_on(self, what: str, where: str, state: _State, context: PlanningContext) -> None:
+        surface_name = _bare(where)
+        surface_name = {"kitchen counter": "counter", "dining table": "table", "shelves": "shelf"}.get(
+            surface_name, surface_name
+        )
+        if surface_name not in context.world.surfaces:
+            surfaces = ", the ".join(context.world.surfaces)
+            raise PlanRefused(f"I can't put things on '{surface_name}'. I can put them on the {surfaces}.")
+        surface = context.belief.surface(surface_name)
+        approach = np.array(context.world.places[context.world.surfaces[surface_name].place].pose[:2])
+        for target in self._objects(what, state, context):
+            spot = free_spot(surface, context.belief, approach, also_taken=state.spots)
+            if spot is None:
+                raise PlanRefused(f"There is no free spot left on the {surface_name}.")
+            state.spots.append(spot)
+            x, y = round(float(spot[0]), 3), round(float(spot[1]), 3)
+            if state.held == target:
+                state.steps.append({"navigate": {"place": context.world.surfaces[surface_name].place}})
+                state.steps.append({"place": {"surface": surface_name, "x": x, "y": y}})
+            else:
+                if state.held is not None:
+                    raise PlanRefused(f"I will be holding the {state.held}; I can carry one thing at a time.")
+                state.steps.append({"fetch": {"object": target, "to": surface_name, "x": x, "y": y}})
+            state.lines.append(f"put the {target} on the {surface_name}")
+            state.held = None
+            state.last = [target]
+
+    # --- objects ------------------------------------------------------------------
+
+    def _objects(self, phrase: str, state: _State, context: PlanningContext) -> list[str]:
+        """The objects a phrase names: one, or several for "all the cubes" and "them"."""
+        words = phrase.strip()
+        if re.fullmatch(r"(?:it|that|this|that one|this one)", words):
+            if not state.last:
+                raise PlanRefused("I don't know what 'it' is; name the object, for example 'the red cube'.")
+            return state.last[-1:]
+        if re.fullmatch(r"(?:them|those|these|both|all of them)", words):
+            if not state.last:
+                raise PlanRefused("I don't know what 'them' are; name the objects.")
+            return list(state.last)
+        group = re.match(r"^(?:all(?: of)?(?: the)?|every|each|both(?: the)?|the two)\s+(?P<rest>.+)$", words)
+        targets = self._all(group["rest"], context) if group else [self._one_object(words, state, context)]
+        state.last = targets
+        return targets
+
+    def _one_object(self, phrase: str, state: _State, context: PlanningContext) -> str:
+        bare = _bare(phrase)
+        if bare in ("it", "that", "this"):
+            return self._objects(bare, state, context)[0]
+        if bare in PERSON_WORDS or bare in _people(context):
+            raise PlanRefused("I can't pick up people.")
+        if bare in context.world.surfaces or _place_name(bare, context) is not None:
+            examples = ", the ".join(list(context.world.objects)[:3])
+            raise PlanRefused(f"The {bare} is too big for me to carry; I can pick up things like the {examples}.")
+        belief = context.belief
+        grounding = ground(phrase, belief, viewer=context.robot_pose)
+        if grounding.verdict == "found" and grounding.best is not None:
+            name = _name_of(grounding.best, context)
+            state.last = [name]
+            return name
+        if grounding.verdict == "ambiguous":
+            options = [_name_of(o, context) for o in grounding.tied]
+            raise Question(Choice(command="", phrase=phrase, options=options), _which(options))
+        named = _by_vocabulary(bare, context)
+        if len(named) == 1:  # known by name, not seen yet: find will look for it
+            state.last = named
+            return named[0]
+        if len(named) > 1:
+            raise Question(Choice(command="", phrase=phrase, options=named), _which(named))
+        raise PlanRefused(_not_seen(bare, context))
+
+    def _all(self, phrase: str, context: PlanningContext) -> list[str]:
+        words = re.findall(r"[a-z]+", phrase)
+        kinds = {KIND_WORDS[w] for w in words if w in KIND_WORDS}
+        colours = {w for w in words if w in {o.colour for o in context.belief.objects.values()}}
+        present = [o for o in context.belief.objects.values() if o.confidence > 0.0 or o.held_by is not None]
+        chosen = [
+            o
+            for o in present
+            if (not kinds or o.kind in kinds) and (not colours or o.colour in colours) and (kinds or colours)
+        ]
+        if not chosen:
+            raise PlanRefused(f"I don't see any {phrase}.")
+        here = np.asarray(context.robot_pose[:2])
+        chosen.sort(key=lambda o: float(np.hypot(*(o.position[:2] - here))))
+        return [_name_of(o, context) for o in chosen]
+
+
+# --- helpers -------------------------------------------------------------------------
+
+
+def split_clauses(command: str) -> list[str]:
+    """Clauses of a normalised command: broken at commas, "and" and "then" only before a new verb.
+
+    "put the red cube and the blue cube on the shelf" stays whole; "pick up the mug and bring it to me" splits.
+    """
+    pieces: list[str] = []
+    position = 0
+    current = ""
+    for match in CLAUSE_BREAK.finditer(command):
+        after = command[match.end() :]
+        current += command[position : match.start()]
+        if STARTS_WITH_VERB.match(after) and current.strip():
+            pieces.append(current.strip())
+            current = ""
+        else:
+            current += command[match.start() : match.end()]
+        position = match.end()
+    current += command[position:]
+    if current.strip(" ,"):
+        pieces.append(current.strip(" ,"))
+    return [p for p in (piece.strip(" ,") for piece in pieces) if p]
+
+
+def pick_option(choice: Choice, reply: str, context: PlanningContext) -> str | None:
+    """Which of a question's options a reply means: by name, by its words, or by order ("the first one")."""
+    text = normalise(reply)
+    ordinals = {"first": 0, "1st": 0, "second": 1, "2nd": 1, "third": 2, "3rd": 2, "last": len(choice.options) - 1}
+    for word, index in ordinals.items():
+        if re.search(rf"\b{word}\b", text) and index < len(choice.options):
+            return choice.options[index]
+    for option in choice.options:
+        if option in text:
+            return option
+    candidates = [o for o in context.belief.objects.values() if _name_of(o, context) in choice.options]
+    if candidates:
+        subset = type(context.belief)(
+            objects={o.id: o for o in candidates},
+            surfaces=context.belief.surfaces,
+            rooms=context.belief.rooms,
+            vocabulary=context.belief.vocabulary,
+        )
+        grounding = ground(text, subset, viewer=context.robot_pose)
+        if grounding.verdict == "found" and grounding.best is not None:
+            return _name_of(grounding.best, context)
+    words = set(re.findall(r"[a-z]+", text)) - {"the", "one", "a", "please"}
+    fitting = [o for o in choice.options if words & set(o.split())]
+    return fitting[0] if len(fitting) == 1 else None
+
+
+def _replace_phrase(command: str, phrase: str, name: str) -> str:
+    """The command with the ambiguous phrase replaced by the chosen name."""
+    if phrase and phrase in command:
+        return command.replace(phrase, f"the {name}", 1)
+    return command
+
+
+def _relative_move(state: _State, x: float) -> None:
+    if not 0.0 < abs(x) <= MAX_STEP:
+        raise PlanRefused(f"I step at most {MAX_STEP:.0f} meters at a time; say where to go instead.")
+    state.steps.append({"move_base": {"relative": True, "x": x}})
+    state.lines.append(f"move {'forward' if x > 0 else 'back'} {abs(x):g} meters")
+
+
+def _distance(number: str | None, unit: str | None, default: float = DEFAULT_STEP) -> float:
+    if number is None:
+        return default
+    value = float(number)
+    if unit and unit.startswith(("cm", "centi")):
+        value /= 100.0
+    elif unit and unit.startswith("step"):
+        value *= 0.5  # a step is about half a metre
+    return value
+
+
+def _bare(phrase: str) -> str:
+    """A phrase without its article and trailing filler: "the kitchen please" → "kitchen"."""
+    phrase = ARTICLE.sub("", phrase.strip())
+    return re.sub(r"\s+(?:please|now|for me|again)$", "", phrase).strip()
+
+
+def _place_name(words: str, context: PlanningContext) -> str | None:
+    """A named place from spoken words: "living room" is living_room; "home" the start."""
+    key = words.replace(" ", "_")
+    if key in context.world.places:
+        return key
+    aliases = {"home": "start", "dining table": "table", "kitchen counter": "counter", "shelves": "shelf"}
+    alias = aliases.get(words)
+    return alias if alias in context.world.places else None
+
+
+def _spoken(name: str) -> str:
+    return name.replace("_", " ")
+
+
+def _people(context: PlanningContext) -> set[str]:
+    return {n for name, person in context.world.people.items() for n in (name, *person.aliases)}
+
+
+def _name_of(tracked: TrackedObject, context: PlanningContext) -> str:
+    """What to call an object in a mission: the world's name for it, else the robot's own id."""
+    if tracked.name in context.world.objects:
+        return tracked.name
+    named = [
+        name
+        for name, declared in context.world.objects.items()
+        if (declared.kind, declared.colour) == (tracked.kind, tracked.colour)
+    ]
+    return named[0] if len(named) == 1 else tracked.id
+
+
+def _by_vocabulary(words: str, context: PlanningContext) -> list[str]:
+    """World names a phrase fits by its words alone (objects not seen yet, but known to exist)."""
+    tokens = set(re.findall(r"[a-z]+", words))
+    kinds = {KIND_WORDS[w] for w in tokens if w in KIND_WORDS}
+    fitting = []
+    for name, declared in context.world.objects.items():
+        if name == words:
+            return [name]
+        if kinds and declared.kind not in kinds:
+            continue
+        if any(w in tokens for w in name.split()) or declared.kind in kinds:
+            colour_words = tokens & {"red", "blue", "green", "yellow", "white", "black", "grey", "orange", "purple"}
+            if colour_words and declared.colour not in colour_words:
+                continue
+            fitting.append(name)
+    return fitting
+
+
+def _which(options: list[str]) -> str:
+    return f"I see {_join([f'a {o}' for o in options])}. Which would you like?"
+
+
+def _not_seen(phrase: str, context: PlanningContext) -> str:
+    seen = sorted({_name_of(o, context) for o in context.belief.objects.values() if o.confidence > 0.0})
+    article = "an" if phrase[:1] in "aeiou" else "a"
+    what = f" I see the {_join(seen)}." if seen else " I have not seen anything yet."
+    return f"I don't see {article} {phrase}.{what}"
+
+
+def _key(name: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "_", name.lower()).strip("_") or "it"
+
+
+def _join(items: list[str]) -> str:
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
