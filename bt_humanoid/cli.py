@@ -1,4 +1,4 @@
-"""Command-line entry points: bt-run and bt-validate.
+"""Command-line entry points: bt-run, bt-plan and bt-validate.
 
 Exit codes: 0 success, 1 mission failed, 2 invalid input. A user error is one
 line on stderr naming the place and what would be valid; never a traceback.
@@ -40,7 +40,8 @@ class _Parser(argparse.ArgumentParser):
 
 def _run_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="bt-run", description="Validate, compile and run a mission headless in MuJoCo.")
-    parser.add_argument("mission", type=Path, help="mission YAML file")
+    parser.add_argument("mission", type=Path, nargs="?", help="mission YAML file (or give --command)")
+    _command_arguments(parser, "plan from an English command instead of a mission file")
     parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
     parser.add_argument("--no-live", action="store_true", help="plain status lines instead of the live tree")
     parser.add_argument("--summary-json", type=Path, help="write the run summary to this JSON file")
@@ -51,8 +52,20 @@ def _run_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> None:
+    parser.add_argument("--command", metavar="TEXT", help=command_help)
+    parser.add_argument("--world", default="apartment", help="world of a command (default: apartment)")
+    parser.add_argument("--robot", default="wheeled_humanoid", help="robot of a command (default: wheeled_humanoid)")
+    parser.add_argument(
+        "--answer", action="append", default=[], metavar="TEXT", help="answer to the planner's question (repeatable)"
+    )
+
+
 def run_main(argv: list[str] | None = None) -> int:
-    args = _run_parser().parse_args(argv)
+    parser = _run_parser()
+    args = parser.parse_args(argv)
+    if (args.mission is None) == (args.command is None):
+        parser.error("give a mission file or --command TEXT (one of them)")
     console = Console(soft_wrap=True)
     try:
         from bt_humanoid.engine.runner import MissionRun
@@ -60,7 +73,13 @@ def run_main(argv: list[str] | None = None) -> int:
 
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
-        spec = MissionLoader().load_file(args.mission)
+        if args.command is not None:
+            outcome = _plan_from_command(args, console)
+            if outcome.spec is None:
+                return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
+            spec = outcome.spec
+        else:
+            spec = MissionLoader().load_file(args.mission)
         run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz)
         recorder = None
         if args.record:
@@ -97,7 +116,7 @@ def run_main(argv: list[str] | None = None) -> int:
         else:
             from bt_humanoid.viz.live import print_event
 
-            console.print(f"mission: {spec.header.mission}  ({args.mission})", highlight=False)
+            console.print(f"mission: {spec.header.mission}  ({args.mission or 'from the command'})", highlight=False)
             run.events.listeners.append(lambda event: print_event(console, event))
             result = run.execute()
     finally:
@@ -133,6 +152,62 @@ def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
     )
     if args.record:
         console.print(f"  video: {args.record}", highlight=False)
+
+
+# --- commands: bt-plan, bt-run --command -----------------------------------------------
+
+
+def _plan_from_command(args: argparse.Namespace, console: Console):
+    """Plan ``--command``; print what the robot says and the mission; ask questions of ``--answer`` or the user."""
+    import yaml
+
+    from bt_humanoid.commanding import context_at_start, plan_command
+
+    if not args.command.strip():
+        raise UserError("--command is empty", hint='say what to do, e.g. --command "pick up the red cube"')
+    answers = iter(args.answer)
+
+    def answer(question: str) -> str | None:
+        console.print(f"[bold]robot:[/] {question}", highlight=False)
+        reply = next(answers, None)
+        if reply is None and sys.stdin.isatty():
+            reply = console.input("[bold]you:[/] ")
+        elif reply is not None:
+            console.print(f"[bold]you:[/] {reply}", highlight=False)
+        return reply
+
+    context = context_at_start(args.world, args.robot)
+    outcome = plan_command(args.command, context, answer)
+    plan = outcome.plan
+    if plan.kind == "mission":
+        console.print(f"[bold]robot:[/] {plan.say}", highlight=False)
+        console.print(yaml.safe_dump(plan.mission, sort_keys=False, allow_unicode=True).rstrip(), highlight=False)
+    elif plan.kind == "stop":
+        console.print(f"[bold]robot:[/] {plan.say}", highlight=False)
+    else:
+        where = "not understood" if plan.kind == "refusal" else "needs an answer (give --answer TEXT)"
+        Console(stderr=True, highlight=False).print(
+            f"[bold red]error:[/] command {args.command!r} {where}: {plan.say}", soft_wrap=True
+        )
+    return outcome
+
+
+def _plan_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="bt-plan", description="Print the mission the planner makes of an English command.")
+    parser.add_argument("text", help='the command, e.g. "pick up the red cube and put it on the counter"')
+    _command_arguments(parser, argparse.SUPPRESS)
+    return parser
+
+
+def plan_main(argv: list[str] | None = None) -> int:
+    args = _plan_parser().parse_args(argv)
+    args.command = args.text
+    console = Console(soft_wrap=True)
+    try:
+        outcome = _plan_from_command(args, console)
+    except UserError as error:
+        return _fail_invalid(error)
+    return EXIT_OK if outcome.plan.kind in ("mission", "stop") else EXIT_INVALID
 
 
 # --- bt-validate ----------------------------------------------------------------------

@@ -100,8 +100,8 @@ def test_target_moved_on_the_table_during_the_approach_is_found_again_and_picked
     scenario, moved = _pick_the_cube_while_it_moves(-0.1, -0.1)  # 14 cm, still within reach
     assert moved, "the fault was never injected"
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
-    noticed = [e for e in scenario.events if e.get("node", "").endswith("stand_near") and e.get("new") == "FAILURE"]
-    assert noticed and "the red cube is no longer where I saw it" in noticed[0]["feedback"]  # then found it again
+    failures = [e.get("feedback") or "" for e in scenario.events if e.get("new") == "FAILURE"]
+    assert any("the red cube is no longer where I saw it" in f for f in failures)  # noticed, then found it again
     assert scenario.truth.in_hand("red cube") == "right"
 
 

@@ -315,7 +315,7 @@ class EmbeddedPlanner:
             raise PlanRefused("There is nobody here to give it to.")
         state.steps.append({"navigate": {"person": person}})
         state.steps.append({"give": {"to": person}})
-        state.lines.append(f"bring it to you and hand over the {state.held}")
+        state.lines.append("bring it to you")
         state.held = None
 
     def _go_to_person(self, state: _State, context: PlanningContext) -> None:
@@ -344,11 +344,12 @@ class EmbeddedPlanner:
             if state.held == target:
                 state.steps.append({"navigate": {"place": context.world.surfaces[surface_name].place}})
                 state.steps.append({"place": {"surface": surface_name, "x": x, "y": y}})
+                state.lines.append(f"put it on the {surface_name}")
             else:
                 if state.held is not None:
                     raise PlanRefused(f"I will be holding the {state.held}; I can carry one thing at a time.")
                 state.steps.append({"fetch": {"object": target, "to": surface_name, "x": x, "y": y}})
-            state.lines.append(f"put the {target} on the {surface_name}")
+                state.lines.append(f"put the {target} on the {surface_name}")
             state.held = None
             state.last = [target]
 

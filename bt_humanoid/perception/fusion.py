@@ -22,7 +22,9 @@ NEW_WEIGHT = 0.5  # share of a new detection in a tracked object's updated posit
 GAIN = 0.35  # confidence gained per sighting
 LOSS = 0.5  # factor on confidence per frame an object should have been seen and was not
 GONE = 0.15  # below this confidence an object is no longer believed to be there
-SIGHT_RANGE = 3.0  # m: farther objects are not expected to be detected
+SIGHT_RANGE = 2.0  # m: a farther object may go undetected, so not seeing it there says nothing
+MIN_APPARENT = 8  # pixels across an object must span before not seeing it counts against it
+BORDER = 8  # pixels: an object this close to the image's edge may be cut off
 
 
 def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame) -> None:
@@ -92,9 +94,11 @@ def _should_be_visible(tracked: TrackedObject, frame: RgbdFrame) -> bool:
     distance = -local[2]
     if distance <= 0.1 or distance > SIGHT_RANGE:
         return False
+    if frame.focal * float(max(tracked.size)) / distance < MIN_APPARENT:
+        return False  # too small in this view to be sure of seeing it
     col = int(frame.centre[0] + frame.focal * local[0] / distance)
     row = int(frame.centre[1] - frame.focal * local[1] / distance)
     height, width = frame.depth.shape
-    if not (0 <= row < height and 0 <= col < width):
+    if not (BORDER <= row < height - BORDER and BORDER <= col < width - BORDER):
         return False
     return bool(frame.depth[row, col] > distance - 0.05)  # nothing nearer in front of it

@@ -45,9 +45,15 @@ class _BaseSkill(PhasedSkill):
     def _tuck_arms(self) -> MotionHandle | None:
         return tuck_empty_arms(self.context)
 
+    def _lower_torso(self) -> MotionHandle | None:
+        return lower_empty_torso(self.context)
+
 
 def tuck_empty_arms(context: SkillContext) -> MotionHandle | None:
-    """Fold every empty arm inside the footprint (an arm that carries something keeps its carry pose)."""
+    """Fold every empty arm inside the footprint (an arm that carries something keeps its carry pose).
+
+    The torso keeps its height meanwhile: lowering it with a hand still over a table would push the hand into it.
+    """
     config = context.robot_config
     tucked = config.postures.get(TUCKED_POSTURE, {})
     joints = {
@@ -57,8 +63,14 @@ def tuck_empty_arms(context: SkillContext) -> MotionHandle | None:
         for j in config.groups.get(f"{side}_arm", [])
         if j in tucked
     }
-    if not context.world_model.held_any():  # nothing to hold up: the torso comes down too
-        joints.update({j: 0.0 for j in config.groups.get("lift", [])})
+    return context.robot.joints.move(joints) if joints else None
+
+
+def lower_empty_torso(context: SkillContext) -> MotionHandle | None:
+    """Bring the torso lift down once the arms are folded, unless a hand holds something up."""
+    if context.world_model.held_any():
+        return None
+    joints = {j: 0.0 for j in context.robot_config.groups.get("lift", [])}
     return context.robot.joints.move(joints) if joints else None
 
 
@@ -97,7 +109,12 @@ class NavigateTo(_BaseSkill):
         return _places_and_objects(params, context)
 
     def phases(self):
-        return [("look ahead", self._look_ahead), ("tuck the arms", self._tuck_arms), ("navigate", self._navigate)]
+        return [
+            ("look ahead", self._look_ahead),
+            ("tuck the arms", self._tuck_arms),
+            ("lower the torso", self._lower_torso),
+            ("navigate", self._navigate),
+        ]
 
     def _navigate(self) -> MotionHandle:
         navigator = self._navigator()
@@ -223,13 +240,33 @@ class BackUp(_BaseSkill):
         return [("back up", self._back_up)]
 
     def _back_up(self) -> MotionHandle:
-        navigator = self._navigator()
-        x, y, yaw = self.context.robot.base.pose()
-        behind = np.array([x, y]) - self.params.distance * np.array([math.cos(yaw), math.sin(yaw)])
-        path = np.linspace([x, y], behind, 20)[5:]  # the first points are where the robot stands
-        if np.any(navigator.grid.clearance_at(path) < navigator.clearance.minimum):
+        self._navigator()
+        handle = back_up(self.context, self.params.distance)
+        if handle is None:
             raise PhaseFailure(f"no room to back up {self.params.distance:.2f} m")
-        return self.context.robot.base.move_to(behind[0], behind[1], yaw, max_speed=BACK_UP_SPEED)
+        return handle
+
+
+def back_up(context: SkillContext, distance: float) -> MotionHandle | None:
+    """Drive straight back ``distance`` metres if the navigation map shows room behind; None if not."""
+    navigator = context.navigator
+    x, y, yaw = context.robot.base.pose()
+    behind = np.array([x, y]) - distance * np.array([math.cos(yaw), math.sin(yaw)])
+    path = np.linspace([x, y], behind, 20)[5:]  # the first points are where the robot stands
+    if navigator is None or np.any(navigator.grid.clearance_at(path) < navigator.clearance.minimum):
+        return None
+    return context.robot.base.move_to(behind[0], behind[1], yaw, max_speed=BACK_UP_SPEED)
+
+
+def at_a_surface(context: SkillContext, within: float = 0.3) -> bool:
+    """Whether the base stands within ``within`` metres of a support surface (its hands may be over it)."""
+    x, y, _ = context.robot.base.pose()
+    reach = context.robot_config.base.footprint_radius + within
+    for surface in context.world_model.surfaces.values():
+        nearest = np.clip([x, y], surface.region[0], surface.region[1])
+        if float(np.hypot(x - nearest[0], y - nearest[1])) < reach:
+            return True
+    return False
 
 
 class ClearMapParams(StrictModel):

@@ -19,13 +19,14 @@ from pydantic import Field
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.perception.grounding import resolve
 from bt_humanoid.skills.manipulation_skills import _ManipulationSkill
-from bt_humanoid.skills.navigation_skills import tuck_empty_arms
+from bt_humanoid.skills.navigation_skills import at_a_surface, back_up, lower_empty_torso, tuck_empty_arms
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel
 
 LOOK_AROUND = (0.0, 1.0, -1.0)  # head pan (rad) of each look when the object is not known yet
 SEARCH_SPEED = 0.6  # m/s between places while searching
+STEP_BACK = 0.35  # m back from a surface before folding the arms to search
 
 
 class FindParams(StrictModel):
@@ -47,10 +48,18 @@ class Find(_ManipulationSkill):
             def distance(item) -> float:
                 return float(np.hypot(*(np.array(item[1].pose[:2]) - here)))
 
+            phases.append(("step back to search", self._step_back))
             phases.append(("fold the arms to search", lambda: None if self.target else tuck_empty_arms(self.context)))
+            phases.append(("lower the torso", lambda: None if self.target else lower_empty_torso(self.context)))
             for name, place in sorted(self.context.world.places.items(), key=distance):
                 phases += [(f"search the {name}", lambda p=place: self._go(p)), *self._look_around(name)]
         return [*phases, ("look at it", self._look_at_it)]
+
+    def _step_back(self) -> MotionHandle | None:
+        """Away from a table before folding the arms: a hand over it would hit it on the way down."""
+        if self.target is not None or not at_a_surface(self.context):
+            return None
+        return back_up(self.context, STEP_BACK)
 
     def _look_around(self, where: str) -> list:
         label = f"look around {where}"

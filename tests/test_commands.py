@@ -1,0 +1,65 @@
+"""Commands end to end: bt-plan's answers and exit codes, and a typed command run to success in the simulator."""
+
+import numpy as np
+import pytest
+
+from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, plan_main, run_main
+from bt_humanoid.commanding import context_at_start, plan_command
+from bt_humanoid.engine.runner import MissionRun
+
+
+def test_bt_plan_prints_the_mission_it_would_run(capsys):
+    assert plan_main(["pick up the red cube and put it on the counter"]) == EXIT_OK
+    out = capsys.readouterr().out
+    assert "robot: I will pick up the red cube and put it on the counter." in out
+    assert "- take:\n      object: red cube" in out and "surface: counter" in out
+
+
+def test_bt_plan_refuses_what_it_cannot_do_with_exit_2(capsys):
+    assert plan_main(["do a backflip"]) == EXIT_INVALID
+    err = capsys.readouterr().err
+    assert "command 'do a backflip' not understood: I can't do a backflip. I can go to a place" in err
+
+
+def test_bt_plan_asks_and_takes_the_answer_from_the_command_line(capsys):
+    # from the start the robot sees a blue cube and a blue bottle on the table
+    assert plan_main(["grab the blue thing"]) == EXIT_INVALID  # a question, and nobody to answer it
+    assert "needs an answer (give --answer TEXT): I see a " in capsys.readouterr().err
+    assert plan_main(["grab the blue thing", "--answer", "the bottle"]) == EXIT_OK
+    out = capsys.readouterr().out
+    assert "you: the bottle" in out and "object: water bottle" in out
+
+
+def test_the_planner_sees_with_the_camera_and_knows_unseen_things_by_name():
+    context = context_at_start("apartment", "wheeled_humanoid")
+    seen = {o.name for o in context.belief.objects.values()}
+    assert seen and seen <= {"blue cube", "red cube", "blue bottle", "white mug", "yellow ball"} | seen
+    assert "coffee mug" not in seen  # in the kitchen, out of sight from the start
+    outcome = plan_command("bring me the coffee mug", context, lambda question: None)
+    assert outcome.spec is not None  # known by name: take will look for it
+
+
+def test_a_typed_command_puts_the_red_cube_on_the_counter():
+    context = context_at_start("apartment", "wheeled_humanoid")
+    outcome = plan_command("put the red cube on the counter", context, lambda question: None)
+    assert outcome.spec is not None, outcome.plan.say
+    run = MissionRun(outcome.spec)
+    result = run.execute()
+    assert result.tree_status == "SUCCESS", result.summary()
+    place = outcome.plan.mission["tree"]["fetch"]
+    x, y, _ = run.truth.object_position("red cube")
+    assert run.truth.rests_on("red cube", "counter") and np.hypot(x - place["x"], y - place["y"]) < 0.03
+    assert run.robot.max_speed() < 0.01
+
+
+@pytest.mark.parametrize("argv", [["--command", "fly to the moon", "--no-live"], ["--command", "  ", "--no-live"]])
+def test_bt_run_with_a_command_it_cannot_do_exits_2_and_moves_nothing(argv, capsys):
+    assert run_main(argv) == EXIT_INVALID
+    assert "error:" in capsys.readouterr().err
+
+
+def test_bt_run_needs_a_mission_or_a_command(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        run_main([])
+    assert exit_info.value.code == EXIT_INVALID
+    assert "give a mission file or --command TEXT" in capsys.readouterr().err
