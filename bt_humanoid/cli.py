@@ -59,6 +59,9 @@ def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> No
     parser.add_argument(
         "--answer", action="append", default=[], metavar="TEXT", help="answer to the planner's question (repeatable)"
     )
+    parser.add_argument("--llm-url", help="OpenAI-compatible endpoint to plan with (or BT_LLM_BASE_URL)")
+    parser.add_argument("--llm-model", help="model name at that endpoint (or BT_LLM_MODEL)")
+    parser.add_argument("--llm-key", help="API key for that endpoint (or BT_LLM_API_KEY)")
 
 
 def run_main(argv: list[str] | None = None) -> int:
@@ -161,7 +164,8 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
     """Plan ``--command``; print what the robot says and the mission; ask questions of ``--answer`` or the user."""
     import yaml
 
-    from bt_humanoid.commanding import context_at_start, plan_command
+    from bt_humanoid.commanding import context_at_start, make_planner, plan_command
+    from bt_humanoid.language.llm import LlmSettings
 
     if not args.command.strip():
         raise UserError("--command is empty", hint='say what to do, e.g. --command "pick up the red cube"')
@@ -176,8 +180,13 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
             console.print(f"[bold]you:[/] {reply}", highlight=False)
         return reply
 
+    settings = LlmSettings.from_environment(args.llm_url, args.llm_model, args.llm_key)
+    if (args.llm_url or args.llm_model) and settings is None:
+        raise UserError(
+            "--llm-url and --llm-model go together", hint="give both, or set BT_LLM_BASE_URL and BT_LLM_MODEL"
+        )
     context = context_at_start(args.world, args.robot)
-    outcome = plan_command(args.command, context, answer)
+    outcome = plan_command(args.command, context, answer, make_planner(settings))
     plan = outcome.plan
     if plan.kind == "mission":
         console.print(f"[bold]robot:[/] {plan.say}", highlight=False)

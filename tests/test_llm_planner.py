@@ -1,0 +1,158 @@
+"""The LLM planner against a local OpenAI-compatible server that answers with scripted plans.
+
+Good, malformed and hallucinated answers: valid plans pass, broken ones are sent back with the error for
+repair, and after too many the embedded planner answers. A cache spares repeated calls.
+"""
+
+import json
+import threading
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+import numpy as np
+import pytest
+
+from bt_humanoid.cli import EXIT_OK, plan_main
+from bt_humanoid.commanding import make_planner
+from bt_humanoid.language.llm import LlmSettings, PlanCache, world_summary
+from bt_humanoid.language.plan import PlanningContext, mission_signature
+from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.testing.scenario import build_run
+from bt_humanoid.testing.told import tell_object_poses
+
+GOOD = {"kind": "mission", "say": "I will fetch the mug.", "tree": {"take": {"object": "coffee mug"}}}
+UNKNOWN_SKILL = {"kind": "mission", "say": "Backflip!", "tree": {"backflip": {"height": 2}}}
+UNKNOWN_OBJECT = {"kind": "mission", "say": "Got it.", "tree": {"take": {"object": "golden key"}}}
+OFF_THE_MAP = {"kind": "mission", "say": "Going.", "tree": {"navigate": {"pose": [40.0, 3.0, 0.0]}}}
+WRONG_TYPE = {"kind": "mission", "say": "Turning.", "tree": {"move_base": {"relative": True, "yaw": "a lot"}}}
+
+
+class ScriptedModel:
+    """A chat-completions endpoint that replies with the next scripted answer and records every request."""
+
+    def __init__(self) -> None:
+        self.script: list[str] = []
+        self.requests: list[dict] = []
+        model = self
+
+        class Handler(BaseHTTPRequestHandler):
+            def do_POST(self) -> None:
+                body = json.loads(self.rfile.read(int(self.headers["Content-Length"])))
+                model.requests.append({"path": self.path, "auth": self.headers.get("Authorization"), **body})
+                content = model.script.pop(0) if model.script else "{}"
+                reply = json.dumps({"choices": [{"message": {"role": "assistant", "content": content}}]}).encode()
+                self.send_response(200)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(reply)))
+                self.end_headers()
+                self.wfile.write(reply)
+
+            def log_message(self, *args) -> None:
+                pass
+
+        self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.url = f"http://127.0.0.1:{self.server.server_port}/v1"
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+
+    def answers(self, *answers) -> None:
+        self.script = [a if isinstance(a, str) else json.dumps(a) for a in answers]
+        self.requests = []
+
+
+@pytest.fixture(scope="module")
+def model():
+    scripted = ScriptedModel()
+    yield scripted
+    scripted.server.shutdown()
+
+
+@pytest.fixture(scope="module")
+def context() -> PlanningContext:
+    run = build_run({"mission": "listen", "tree": {"wait": {"seconds": 0}}})
+    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
+    return PlanningContext(load_world_config("apartment"), run.context.world_model, np.zeros(3))
+
+
+def _planner(model, repairs: int = 2):
+    planner = make_planner(LlmSettings(model.url, "scripted", api_key="secret", max_repairs=repairs))
+    planner.cache = PlanCache()
+    return planner
+
+
+def test_a_good_plan_is_validated_and_used(model, context):
+    model.answers(GOOD)
+    plan = _planner(model).plan("bring the mug", context)
+    assert plan.kind == "mission" and mission_signature(plan.mission["tree"]) == ["take coffee mug"]
+    request = model.requests[0]
+    assert request["path"] == "/v1/chat/completions" and request["auth"] == "Bearer secret"
+    prompt = request["messages"][0]["content"]
+    assert "| `take` (behaviour)" in prompt and '"coffee mug"' in prompt  # generated from registry and world
+    assert request["response_format"] == {"type": "json_object"}
+
+
+@pytest.mark.parametrize(
+    ("bad", "problem"),
+    [
+        ("this is not json", "not JSON"),
+        (UNKNOWN_SKILL, "unknown skill or node kind 'backflip'"),
+        (UNKNOWN_OBJECT, "unknown object 'golden key'"),
+        (OFF_THE_MAP, "(40.0, 3.0) is outside the map"),
+        (WRONG_TYPE, "yaw"),
+    ],
+)
+def test_a_bad_answer_goes_back_with_its_error_and_the_repair_is_used(model, context, bad, problem):
+    model.answers(bad, GOOD)
+    planner = _planner(model)
+    plan = planner.plan("bring the mug", context)
+    assert plan.kind == "mission" and mission_signature(plan.mission["tree"]) == ["take coffee mug"]
+    assert len(model.requests) == 2
+    feedback = model.requests[1]["messages"][-1]["content"]
+    assert feedback.startswith("That answer is not valid:") and problem in feedback, feedback
+
+
+def test_after_too_many_bad_answers_the_embedded_planner_answers(model, context):
+    model.answers(UNKNOWN_SKILL, UNKNOWN_OBJECT, OFF_THE_MAP)
+    planner = _planner(model, repairs=2)
+    plan = planner.plan("pick up the red cube", context)
+    assert len(model.requests) == 3
+    assert plan.kind == "mission" and mission_signature(plan.mission["tree"]) == ["take red cube"]
+    assert "planned offline: the language model gave no valid plan in 3 tries" in plan.say
+
+
+def test_an_unreachable_endpoint_falls_back_with_the_reason(context):
+    planner = make_planner(LlmSettings("http://127.0.0.1:9/v1", "none", timeout=2.0))
+    plan = planner.plan("turn left ninety degrees", context)
+    assert plan.kind == "mission" and mission_signature(plan.mission["tree"]) == ["turn 90"]
+    assert "planned offline: the language model at http://127.0.0.1:9/v1 failed" in plan.say
+
+
+def test_a_repeated_command_comes_from_the_cache(model, context):
+    model.answers(GOOD)
+    planner = _planner(model)
+    first = planner.plan("bring the mug", context)
+    second = planner.plan("Bring the mug", context)
+    assert len(model.requests) == 1 and first.mission["tree"] == second.mission["tree"]
+
+
+def test_questions_and_refusals_from_the_model_are_passed_on(model, context):
+    model.answers(
+        {"kind": "question", "say": "Which cube?", "options": ["red cube", "blue cube"]},
+        {"kind": "refusal", "say": "I cannot fly."},
+    )
+    planner = _planner(model)
+    question = planner.plan("pick up the cube", context)
+    assert question.kind == "question" and question.choice.options == ["red cube", "blue cube"]
+    refusal = planner.plan("fly", context)
+    assert refusal.kind == "refusal" and refusal.say == "I cannot fly."
+
+
+def test_the_world_summary_is_what_the_robot_believes(context):
+    summary = json.loads(world_summary(context))
+    assert {o["name"] for o in summary["objects_seen"]} == set(context.world.objects)
+    assert summary["surfaces"] == ["table", "counter", "shelf"] and "kitchen" in summary["places"]
+
+
+def test_bt_plan_uses_the_endpoint_given_on_the_command_line(model, capsys):
+    model.answers(GOOD)
+    code = plan_main(["bring the mug", "--llm-url", model.url, "--llm-model", "scripted"])
+    assert code == EXIT_OK
+    assert "robot: I will fetch the mug." in capsys.readouterr().out
