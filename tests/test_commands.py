@@ -6,6 +6,7 @@ import pytest
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, plan_main, run_main
 from bt_humanoid.commanding import context_at_start, plan_command
 from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.language.embedded import EmbeddedPlanner
 
 
 def test_bt_plan_prints_the_mission_it_would_run(capsys):
@@ -63,3 +64,25 @@ def test_bt_run_needs_a_mission_or_a_command(capsys):
         run_main([])
     assert exit_info.value.code == EXIT_INVALID
     assert "give a mission file or --command TEXT" in capsys.readouterr().err
+
+
+def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
+    context = context_at_start("apartment", "wheeled_humanoid")
+    outcome = plan_command("walk forward three meters", context, lambda question: None)
+    run = MissionRun(outcome.spec)
+    planner = EmbeddedPlanner()
+    stopped: list[float] = []
+
+    def type_stop_after_a_second() -> None:
+        if not stopped and run.sim.time > 1.5 and planner.plan("stop!", context).kind == "stop":
+            assert run.robot.max_speed() > 0.1  # in mid-motion
+            run.request_stop("stop (typed)")
+            stopped.append(run.sim.time)
+
+    run.executor.observers.append(type_stop_after_a_second)
+    result = run.execute()
+    assert stopped and result.tree_status == "FAILURE" and result.safety == "stop: stop (typed)"
+    assert run.robot.max_speed() < 0.01 and result.said[-1] == "I have stopped."
+    assert any(e["event"] == "rest" for e in result.events.events)  # how fast: python -m bt_humanoid.benchmarks.stop
+    x, _, _ = run.truth.robot_pose()
+    assert x < 2.5  # stopped well short of the 3 m it was told to walk

@@ -22,6 +22,9 @@ POSITION_GAIN = 2.0  # 1/s: velocity correction per metre (radian) of tracking e
 BLOCKED_ERROR = 0.3  # m: a tracking error this large means something is in the way
 SETTLE_TIMEOUT = 2.0  # s after the plan ends before a goal that has not arrived fails
 
+BRAKE_ACCEL = 2.0  # × the base's acceleration limits when braking: an emergency stop, not a smooth one
+BRAKE_JERK = 8.0  # × its jerk limits when braking
+
 
 def wrap_angle(angle: float) -> float:
     """Angle in [-pi, pi)."""
@@ -101,8 +104,8 @@ class BaseDriver:
         limits = self.config.limits
         plan_limits = (
             np.array([limits.max_speed, limits.max_speed, limits.max_yaw_rate]) * 1.5,
-            np.array([limits.max_accel, limits.max_accel, limits.max_yaw_accel]) * 2.0,
-            np.array([limits.max_jerk, limits.max_jerk, limits.max_yaw_jerk]) * 4.0,
+            np.array([limits.max_accel, limits.max_accel, limits.max_yaw_accel]) * BRAKE_ACCEL,
+            np.array([limits.max_jerk, limits.max_jerk, limits.max_yaw_jerk]) * BRAKE_JERK,
         )
         self.reference = self.pose()
         self.trajectory = plan_trajectory(

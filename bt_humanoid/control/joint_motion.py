@@ -20,6 +20,8 @@ from bt_humanoid.sim.robot_io import MujocoRobotIO
 SETTLE_TOLERANCE = 0.03  # rad (or m for fingers): tracking error that counts as arrived
 SETTLE_TIMEOUT = 1.0  # s after the trajectory ends before a goal fails
 
+BRAKE_SCALE = (1.0, 3.0, 8.0)  # velocity, acceleration, jerk limits × this when braking: stop fast, not smooth
+
 
 @dataclass
 class _Goal:
@@ -84,7 +86,7 @@ class JointReferenceController:
             self.velocity[moving],
             self.acceleration[moving],
             None,
-            tuple(limit[moving] for limit in self.limits),
+            tuple(limit[moving] * scale for limit, scale in zip(self.limits, BRAKE_SCALE, strict=True)),
             brake=True,
         )
         self.goals.append(_Goal(MotionHandle("braking"), moving, trajectory, self.io.time, None, False))

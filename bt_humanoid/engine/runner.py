@@ -132,7 +132,11 @@ class MissionRun:
         return map_world_model(self.spec.known.world, self.sim.model)
 
     def request_stop(self, reason: str = "stop requested") -> None:
+        """Stop now: every motion starts braking at once; the tree is halted at its next tick."""
+        first = self.stop_monitor.reason is None
         self.stop_monitor.request(reason)
+        if first:
+            self.robot.brake()
 
     def execute(self) -> RunResult:
         started = time.perf_counter()
@@ -141,6 +145,8 @@ class MissionRun:
         finally:
             if self.perceiver is not None:
                 self.perceiver.close()  # its off-screen GL contexts: one per run adds up over a benchmark
+        if self.stop_monitor.reason is not None:
+            self.context.speak("I have stopped.")  # at rest now: executor.run brakes to rest before it returns
         wall = time.perf_counter() - started
         conditions = [check_condition(c, self.truth) for c in self.spec.header.success]
         violation = self.supervisor.violation

@@ -1,0 +1,125 @@
+"""Stop benchmark: how fast a typed "stop" brings every motion to rest, in mid-motion.
+
+    python -m bt_humanoid.benchmarks.stop --trials 25
+
+Each trial runs one of several missions planned from commands (drive to the
+kitchen, walk forward, turn around, wave, pick up the red cube) and, at a
+random moment while the robot moves faster than 5 cm/s, delivers "stop" the
+way the terminal does: it is planned (the planner answers "stop") and the
+run's stop request is raised. Latency is simulation time from that moment to
+every joint and base speed below 1 cm/s (or rad/s), measured at every
+control step. Prints the median, p95 and worst latency and the speed when
+the stop came. Pinned to one CPU core; ``--json PATH`` also writes the
+figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bt_humanoid.benchmarks.common import percentile, pin_to_one_core, save_figures
+from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.language.embedded import EmbeddedPlanner
+from bt_humanoid.language.plan import PlanningContext
+from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.perception.map_knowledge import map_world_model
+from bt_humanoid.sim.world_config import load_world_config
+
+COMMANDS = (
+    "go to the kitchen",
+    "walk forward three meters",
+    "turn around",
+    "wave three times",
+    "pick up the red cube",
+)
+MOVING = 0.05  # m/s (or rad/s): the robot counts as in motion above this
+AT_REST = 0.01  # m/s (or rad/s): every speed below this is rest
+EARLIEST = 1.0  # s of simulation before a stop may come
+
+
+def stop_trial(command: str, rng: np.random.Generator) -> tuple[float, float] | None:
+    """(latency s, speed when stopped) for one run of ``command`` stopped at a random moving moment."""
+    world = load_world_config("apartment")
+    planner = EmbeddedPlanner()
+    probe = {"mission": "probe", "tree": {"wait": {"seconds": 0}}}
+    run = MissionRun(MissionLoader().load_data(probe))
+    context = PlanningContext(world, map_world_model(world, run.sim.model), run.robot.base.pose())
+    run.perceiver and run.perceiver.close()
+    plan = planner.plan(command, context)
+    run = MissionRun(MissionLoader().load_data(plan.mission))
+    stop_after = EARLIEST + float(rng.uniform(0.0, 3.0))
+    state: dict[str, float] = {}
+
+    def watch() -> None:
+        now, speed = run.sim.time, run.robot.max_speed()
+        if "stopped" not in state and now >= stop_after and speed > MOVING:
+            if planner.plan("stop", context).kind == "stop":  # what the terminal does with a typed "stop"
+                run.request_stop("stop (typed)")
+                state["stopped"], state["speed"] = now, speed
+        elif "stopped" in state and "rest" not in state and speed < AT_REST:
+            state["rest"] = now
+
+    run.executor.observers.append(watch)
+    run.execute()
+    if "stopped" not in state or "rest" not in state:
+        return None  # finished before a moving moment came, or never came to rest (reported)
+    return state["rest"] - state["stopped"], state["speed"]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=25, help="stopped runs (default 25)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    parser.add_argument("--json", type=Path, help="also write the figures here")
+    args = parser.parse_args(argv)
+    if args.trials < 1:
+        parser.error("--trials must be at least 1")
+    pin_to_one_core()
+    rng = np.random.default_rng(args.seed)
+    print(f"bt-humanoid stop benchmark: {args.trials} stops in mid-motion, seed {args.seed} (one core)")
+    started = time.perf_counter()
+    latencies: list[float] = []
+    speeds: list[float] = []
+    missed = 0
+    for index in range(args.trials):
+        command = COMMANDS[index % len(COMMANDS)]
+        outcome = stop_trial(command, rng)
+        if outcome is None:
+            missed += 1
+            print(f"  {index + 1}/{args.trials} {command!r}: no stop in mid-motion (finished first or kept moving)")
+            continue
+        latency, speed = outcome
+        latencies.append(latency)
+        speeds.append(speed)
+        print(
+            f"  {index + 1}/{args.trials} {command!r}: stopped at {speed:.2f} m/s, "
+            f"at rest after {latency * 1000:.0f} ms"
+        )
+    figures = {
+        "trials": args.trials,
+        "stopped": len(latencies),
+        "missed": missed,
+        "latency_median_ms": statistics.median(latencies) * 1000 if latencies else None,
+        "latency_p95_ms": percentile(latencies, 0.95) * 1000 if latencies else None,
+        "latency_max_ms": max(latencies) * 1000 if latencies else None,
+        "speed_at_stop_median": statistics.median(speeds) if speeds else None,
+        "wall_s": round(time.perf_counter() - started, 1),
+    }
+    print()
+    if latencies:
+        print(
+            f"  stop → every speed below 1 cm/s: median {figures['latency_median_ms']:.0f} ms, "
+            f"p95 {figures['latency_p95_ms']:.0f} ms, worst {figures['latency_max_ms']:.0f} ms of simulation time "
+            f"(target median ≤ 300 ms) over {len(latencies)} stops"
+        )
+    save_figures(args.json, figures)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
