@@ -17,16 +17,14 @@ CPU core; ``--json PATH`` also writes the figures.
 
 from __future__ import annotations
 
-import argparse
 import math
 import statistics
 import time
 from dataclasses import asdict, dataclass
-from pathlib import Path
 
 import numpy as np
 
-from bt_humanoid.benchmarks.common import percentile, pin_to_one_core, save_figures
+from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
 from bt_humanoid.control.stance import MAX_DEPTH, stance_for
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.world_model import SupportSurface
@@ -186,21 +184,15 @@ def summarize(kind: str, trials: list[Trial], outcomes: list[Outcome]) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--trials", type=int, default=50, help="trials per kind (default 50)")
+    parser = benchmark_parser(__doc__, "trials", 50, "trials per kind")
     parser.add_argument("--kinds", nargs="+", choices=list(OBJECTS), default=list(OBJECTS), help="object kinds")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the scenes (default 0)")
     parser.add_argument(
         "--perception",
         choices=["camera", "told"],
         default="camera",
         help="objects known only once the head camera has seen them (default), or told where they are",
     )
-    parser.add_argument("--json", type=Path, help="also write the figures here")
-    args = parser.parse_args(argv)
-    if args.trials < 1:
-        parser.error("--trials must be at least 1")
-    pin_to_one_core()
+    args = parse_benchmark_args(parser, argv, "trials")
     rng = np.random.default_rng(args.seed)
     probe = build_run({"mission": "probe", "tree": {"wait": {"seconds": 0}}})
     surface = probe.context.world_model.surface(SURFACE)

@@ -15,17 +15,15 @@ writes the figures.
 
 from __future__ import annotations
 
-import argparse
 import itertools
 import math
 import statistics
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from bt_humanoid.benchmarks.common import percentile, pin_to_one_core, save_figures
+from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
 from bt_humanoid.navigation.grid_astar import grid_route_length
 from bt_humanoid.testing.scenario import build_run
 
@@ -125,18 +123,12 @@ def run_one(start: tuple[float, float, float], goal: str, world: str = "apartmen
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--starts", type=int, default=20, help="random start poses (default 20)")
+    parser = benchmark_parser(__doc__, "starts", 20, "random start poses")
     parser.add_argument("--goals", nargs="+", choices=GOALS, default=list(GOALS), help="named goals")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the start poses (default 0)")
     parser.add_argument(
         "--world", default="apartment", help="apartment, or apartment_busy (a person walks a loop across the middle)"
     )
-    parser.add_argument("--json", type=Path, help="also write the figures here")
-    args = parser.parse_args(argv)
-    if args.starts < 1:
-        parser.error("--starts must be at least 1")
-    pin_to_one_core()
+    args = parse_benchmark_args(parser, argv, "starts")
     started = time.perf_counter()
     starts = random_starts(args.starts, np.random.default_rng(args.seed), args.world)
     total = len(starts) * len(args.goals)

@@ -19,17 +19,15 @@ latency per frame (rendering timed apart). Pinned to one CPU core;
 
 from __future__ import annotations
 
-import argparse
 import math
 import statistics
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from bt_humanoid.benchmarks.common import pin_to_one_core, save_figures
+from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
 from bt_humanoid.perception.detector import detect
 from bt_humanoid.perception.rgbd_camera import RgbdCamera
 from bt_humanoid.testing.scenario import build_run
@@ -183,14 +181,8 @@ def _in_image(camera: RgbdCamera, point: np.ndarray) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", type=int, default=100, help="random scenes (default 100)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    parser.add_argument("--json", type=Path, help="also write the figures here")
-    args = parser.parse_args(argv)
-    if args.scenes < 1:
-        parser.error("--scenes must be at least 1")
-    pin_to_one_core()
+    parser = benchmark_parser(__doc__, "scenes", 100, "random scenes")
+    args = parse_benchmark_args(parser, argv, "scenes")
     rng = np.random.default_rng(args.seed)
     print(f"bt-humanoid perception benchmark: {args.scenes} scenes, seed {args.seed} (one core)")
     started = time.perf_counter()

@@ -15,14 +15,12 @@ figures.
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 
-from bt_humanoid.benchmarks.common import percentile, pin_to_one_core, save_figures
+from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.language.plan import PlanningContext
@@ -72,14 +70,8 @@ def stop_trial(command: str, rng: np.random.Generator) -> tuple[float, float] | 
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--trials", type=int, default=25, help="stopped runs (default 25)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    parser.add_argument("--json", type=Path, help="also write the figures here")
-    args = parser.parse_args(argv)
-    if args.trials < 1:
-        parser.error("--trials must be at least 1")
-    pin_to_one_core()
+    parser = benchmark_parser(__doc__, "trials", 25, "stopped runs")
+    args = parse_benchmark_args(parser, argv, "trials")
     rng = np.random.default_rng(args.seed)
     print(f"bt-humanoid stop benchmark: {args.trials} stops in mid-motion, seed {args.seed} (one core)")
     started = time.perf_counter()
