@@ -40,8 +40,11 @@ class _Parser(argparse.ArgumentParser):
 
 def _run_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="bt-run", description="Validate, compile and run a mission headless in MuJoCo.")
-    parser.add_argument("mission", type=Path, nargs="?", help="mission YAML file (or give --command)")
+    parser.add_argument("mission", type=Path, nargs="?", help="mission YAML file (or give --command or --interactive)")
     _command_arguments(parser, "plan from an English command instead of a mission file")
+    parser.add_argument(
+        "--interactive", action="store_true", help="type commands (and answers, and 'stop') one after another"
+    )
     parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
     parser.add_argument("--no-live", action="store_true", help="plain status lines instead of the live tree")
     parser.add_argument("--summary-json", type=Path, help="write the run summary to this JSON file")
@@ -67,9 +70,11 @@ def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> No
 def run_main(argv: list[str] | None = None) -> int:
     parser = _run_parser()
     args = parser.parse_args(argv)
-    if (args.mission is None) == (args.command is None):
-        parser.error("give a mission file or --command TEXT (one of them)")
+    if sum((args.mission is not None, args.command is not None, args.interactive)) != 1:
+        parser.error("give a mission file, --command TEXT or --interactive (one of them)")
     console = Console(soft_wrap=True)
+    if args.interactive:
+        return _interactive(args, console)
     try:
         from bt_humanoid.engine.runner import MissionRun
         from bt_humanoid.mission.loader import MissionLoader
@@ -199,6 +204,35 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
             f"[bold red]error:[/] command {args.command!r} {where}: {plan.say}", soft_wrap=True
         )
     return outcome
+
+
+def _interactive(args: argparse.Namespace, console: Console) -> int:
+    """Read commands from the terminal until end of input; the robot works on one simulation throughout."""
+    import queue
+    import threading
+
+    from bt_humanoid.commanding import InteractiveSession, make_planner
+    from bt_humanoid.language.llm import LlmSettings
+
+    lines: queue.Queue[str | None] = queue.Queue()
+
+    def read() -> None:
+        for line in sys.stdin:
+            lines.put(line.rstrip("\n"))
+        lines.put(None)
+
+    def say(text: str) -> None:
+        console.print(f"[bold]robot:[/] {text}", highlight=False)
+
+    try:
+        settings = LlmSettings.from_environment(args.llm_url, args.llm_model, args.llm_key)
+        session = InteractiveSession(args.world, args.robot, lines, say, make_planner(settings))
+    except UserError as error:
+        return _fail_invalid(error)
+    say("Ready. Tell me what to do; 'stop' stops me; end with Ctrl-D.")
+    threading.Thread(target=read, daemon=True).start()
+    session.serve()
+    return EXIT_OK
 
 
 def _plan_parser() -> argparse.ArgumentParser:

@@ -8,12 +8,14 @@ that belief, never the simulator.
 
 from __future__ import annotations
 
+import queue
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 from bt_humanoid.errors import UserError
-from bt_humanoid.language.embedded import MAX_STEP, EmbeddedPlanner
+from bt_humanoid.language.embedded import MAX_STEP, EmbeddedPlanner, is_stop
 from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
@@ -124,3 +126,91 @@ def plan_command(
     if plan.kind == "mission" and plan.mission is not None:
         spec = MissionLoader().load_data(plan.mission, name="<command>")
     return CommandOutcome(plan, spec, dialogue)
+
+
+class InteractiveSession:
+    """Typed commands and answers, one after another, on one simulation: the robot keeps its place and belief.
+
+    ``lines`` delivers what the person types (None when they are done). While a mission runs, a typed "stop"
+    stops it at once; anything else typed meanwhile waits until the robot is free.
+    """
+
+    def __init__(
+        self,
+        world: str,
+        robot: str,
+        lines: queue.Queue[str | None],
+        say: Callable[[str], None],
+        planner: EmbeddedPlanner | LlmPlanner | None = None,
+    ) -> None:
+        from bt_humanoid.engine.runner import MissionRun
+
+        self.lines = lines
+        self.say = say
+        self.planner = planner or EmbeddedPlanner()
+        self.pending: deque[str] = deque()
+        idle = {"mission": "ready", "world": world, "robot": robot, "tree": {"wait": {"seconds": 0}}}
+        self.run = MissionRun(MissionLoader().load_data(idle, name="<interactive>"), speak=say)
+        self.run.executor.observers.append(self._listen_while_busy)
+        self.results: list[Any] = []
+        self.finished = False
+        if self.run.perceiver is not None:
+            self.run.perceiver.look()
+
+    def serve(self) -> None:
+        """Take commands until the person is done; every mission runs to its end and the robot to rest."""
+        try:
+            while (text := self._next_line()) is not None:
+                if text.strip():
+                    self._command(text)
+        finally:
+            if self.run.perceiver is not None:
+                self.run.perceiver.close()
+
+    def _command(self, text: str) -> None:
+        context = PlanningContext(
+            self.run.context.world, self.run.context.world_model, self.run.robot.base.pose(), self.run.spec.header.robot
+        )
+        outcome = plan_command(text, context, self._ask, self.planner)
+        plan = outcome.plan
+        if plan.kind == "stop":
+            self.say("I am not moving.")
+            return
+        if outcome.spec is None:
+            self.say(plan.say)
+            return
+        self.say(plan.say)
+        self.run.follow_with(outcome.spec)
+        result = self.run.execute(keep_open=True)
+        self.results.append(result)
+        if result.safety and result.safety.startswith("stop"):
+            return  # it said that it stopped
+        self.say("Done." if result.success else f"I could not finish: {result.cause or result.tree_status}.")
+
+    def _ask(self, question: str) -> str | None:
+        self.say(question)
+        return self._next_line()
+
+    def _next_line(self) -> str | None:
+        if self.pending:
+            return self.pending.popleft()
+        if self.finished:
+            return None
+        line = self.lines.get()
+        self.finished = line is None
+        return line
+
+    def _listen_while_busy(self) -> None:
+        """Between control steps: a typed "stop" stops the mission now; other lines wait their turn."""
+        while True:
+            try:
+                line = self.lines.get_nowait()
+            except queue.Empty:
+                return
+            if line is None:
+                self.finished = True
+                return
+            if self.run.stop_monitor.reason is None and is_stop(line):
+                self.run.request_stop("stop (typed)")
+            else:
+                self.pending.append(line)

@@ -1,10 +1,12 @@
 """Commands end to end: bt-plan's answers and exit codes, and a typed command run to success in the simulator."""
 
+import queue
+
 import numpy as np
 import pytest
 
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, plan_main, run_main
-from bt_humanoid.commanding import context_at_start, plan_command
+from bt_humanoid.commanding import InteractiveSession, context_at_start, plan_command
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.language.embedded import EmbeddedPlanner
 
@@ -63,7 +65,7 @@ def test_bt_run_needs_a_mission_or_a_command(capsys):
     with pytest.raises(SystemExit) as exit_info:
         run_main([])
     assert exit_info.value.code == EXIT_INVALID
-    assert "give a mission file or --command TEXT" in capsys.readouterr().err
+    assert "give a mission file, --command TEXT or --interactive" in capsys.readouterr().err
 
 
 def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
@@ -86,3 +88,29 @@ def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
     assert any(e["event"] == "rest" for e in result.events.events)  # how fast: python -m bt_humanoid.benchmarks.stop
     x, _, _ = run.truth.robot_pose()
     assert x < 2.5  # stopped well short of the 3 m it was told to walk
+
+
+def test_an_interactive_session_takes_commands_answers_and_a_stop_on_one_simulation():
+    lines: queue.Queue = queue.Queue()
+    said: list[str] = []
+    session = InteractiveSession("apartment", "wheeled_humanoid", lines, said.append)
+    drive_started: list[float] = []
+
+    def type_stop_two_seconds_into_the_drive() -> None:  # typed while the robot works
+        if said and said[-1] == "I will go to the kitchen." and not drive_started:
+            drive_started.append(session.run.sim.time)
+        if len(drive_started) == 1 and session.run.sim.time > drive_started[0] + 2.0:
+            lines.put("stop")
+            drive_started.append(session.run.sim.time)
+
+    session.run.executor.observers.append(type_stop_two_seconds_into_the_drive)
+    for line in ["grab the blue thing", "the bottle", "go to the kitchen", "do a backflip", None]:
+        lines.put(line)
+    session.serve()
+    assert said[0].startswith("I see a") and "blue cube" in said[0] and "water bottle" in said[0]
+    assert said[1] == "I will pick up the water bottle." and "Done." in said
+    assert session.run.truth.in_hand("water bottle") == "right"  # still holding it: one simulation throughout
+    assert "I will go to the kitchen." in said and "I have stopped." in said
+    assert session.results[-1].safety == "stop: stop (typed)"
+    assert said[-1].startswith("I can't do a backflip.")
+    assert session.run.robot.max_speed() < 0.01

@@ -14,6 +14,7 @@ from py_trees.common import Status
 from bt_humanoid.control.robot import RobotController
 from bt_humanoid.engine.events import EventLog
 from bt_humanoid.engine.executor import Executor
+from bt_humanoid.errors import UserError
 from bt_humanoid.mission.compiler import CompiledMission, Compiler
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.mission.success import ConditionResult, check_condition
@@ -100,7 +101,7 @@ class MissionRun:
             robot=self.robot,
             clock=lambda: self.sim.time,
             max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),
-            blackboard=Blackboard(header.blackboard),
+            blackboard=Blackboard(header.blackboard),  # both set again per mission by _prepare
             speak=say,
             world_model=self.initial_world_model(),
             navigator=self.navigator,
@@ -111,6 +112,15 @@ class MissionRun:
             self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, "base")
             self.robot.planners.append(self.perceiver)
             self.context.perceiver = self.perceiver
+        self._prepare(self.spec)
+
+    def _prepare(self, spec: MissionSpec) -> None:
+        """Safety monitors, the compiled tree and its executor for ``spec``, on this run's simulation and robot."""
+        self.spec = spec
+        header, defaults = spec.header, spec.known.robot_config.safety
+        safety = header.safety
+        self.context.blackboard = Blackboard(header.blackboard)
+        self.context.max_base_speed = min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed)
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget
         margin = safety.joint_limit_margin if safety.joint_limit_margin is not None else defaults.joint_limit_margin
@@ -124,8 +134,20 @@ class MissionRun:
         def log_retry(policy) -> None:
             self.events.add(self.sim.time, "retry", node=policy.decorated.bt_path, message=policy.feedback_message)
 
-        self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_retry).compile(self.spec)
+        self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_retry).compile(spec)
+        observers = self.executor.observers if hasattr(self, "executor") else []
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
+        self.executor.observers.extend(observers)
+
+    def follow_with(self, spec: MissionSpec) -> None:
+        """Make ``spec`` the next mission, from where the last one left the robot and the world (and the belief)."""
+        same = (spec.header.world, spec.header.robot) == (self.spec.header.world, self.spec.header.robot)
+        if not same:
+            raise UserError(
+                f"mission '{spec.header.mission}' is for {spec.header.world}/{spec.header.robot}; "
+                f"this run is {self.spec.header.world}/{self.spec.header.robot}"
+            )
+        self._prepare(spec)
 
     def initial_world_model(self) -> WorldModel:
         """What the robot knows at the start: its map (surfaces, people, names of things) and no objects yet."""
@@ -138,12 +160,13 @@ class MissionRun:
         if first:
             self.robot.brake()
 
-    def execute(self) -> RunResult:
+    def execute(self, keep_open: bool = False) -> RunResult:
+        """Run the mission to its end and the robot to rest; ``keep_open`` for another mission after it."""
         started = time.perf_counter()
         try:
-            status = self.executor.run(max_time=self.time_budget + 1.0)
+            status = self.executor.run(max_time=self.sim.time + self.time_budget + 1.0)
         finally:
-            if self.perceiver is not None:
+            if self.perceiver is not None and not keep_open:
                 self.perceiver.close()  # its off-screen GL contexts: one per run adds up over a benchmark
         if self.stop_monitor.reason is not None:
             self.context.speak("I have stopped.")  # at rest now: executor.run brakes to rest before it returns

@@ -52,8 +52,9 @@ VERB += r"drive|move|head|navigate|come|return|turn|rotate|spin|face|find|look|s
 VERB += r"announce|wave|stop|halt|freeze|back|step)\b"
 STARTS_WITH_VERB = re.compile(rf"^{VERB}")
 
+STOP = re.compile(r"^(?:stop|halt|freeze|stand still|abort|cancel)\b")
 PATTERNS: list[tuple[str, re.Pattern[str]]] = [
-    ("stop", re.compile(r"^(?:stop|halt|freeze|stand still|abort|cancel)\b")),
+    ("stop", STOP),
     ("say", re.compile(r"^(?:say|tell (?:me|us|them|everyone)|announce)\s+(?P<text>.+)$")),
     ("wave", re.compile(r"^wave\b(?:.*?\b(?P<times>\d+)\s+times)?")),
     (
@@ -415,6 +416,12 @@ class EmbeddedPlanner:
 
 
 # --- helpers -------------------------------------------------------------------------
+
+
+def is_stop(text: str) -> bool:
+    """Whether a command asks the robot to stop (its first clause does): cheap enough for every typed line."""
+    clauses = split_clauses(normalise(text))
+    return bool(clauses) and STOP.match(clauses[0]) is not None
 
 
 def split_clauses(command: str) -> list[str]:
