@@ -120,6 +120,14 @@ def test_and_splits_clauses_only_before_a_verb():
     ]
 
 
+def test_a_second_verb_starts_a_clause_even_without_and_as_speech_recognition_gives_it():
+    assert split_clauses("pick up the red cube put it on the counter") == [
+        "pick up the red cube",
+        "put it on the counter",
+    ]
+    assert split_clauses("say pick up your toys") == ["say pick up your toys"]  # what is said stays whole
+
+
 def test_embedded_planning_is_fast_once_models_are_loaded(planner, context):
     planner.plan("bring me something to drink", context)  # loads the sentence embeddings once
     times = [planner.plan(c["text"], context).planning_time for c in COMMANDS]

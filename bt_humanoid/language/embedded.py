@@ -444,7 +444,21 @@ def split_clauses(command: str) -> list[str]:
     current += command[position:]
     if current.strip(" ,"):
         pieces.append(current.strip(" ,"))
-    return [p for p in (piece.strip(" ,") for piece in pieces) if p]
+    # speech drops the little words: "pick up the red cube put it on the counter" is two clauses too
+    return [part for piece in pieces if piece.strip(" ,") for part in _split_unjoined(piece.strip(" ,"))]
+
+
+UNJOINED = re.compile(r"\s(?=(?:put|place|bring|go|turn|walk|pick up|grab|find|wave|give me|hand me|come)\b)")
+
+
+def _split_unjoined(clause: str) -> list[str]:
+    """A clause broken before a second command verb (not in what a clause says aloud)."""
+    if re.match(r"^(?:say|tell|announce)\b", clause):
+        return [clause]
+    parts = [p.strip() for p in UNJOINED.split(clause) if p.strip()]
+    if any(len(p.split()) < 2 for p in parts):  # "go back", "turn around": a verb needs an object or a direction
+        return [clause]
+    return parts
 
 
 def pick_option(choice: Choice, reply: str, context: PlanningContext) -> str | None:
