@@ -45,6 +45,7 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--interactive", action="store_true", help="type commands (and answers, and 'stop') one after another"
     )
+    parser.add_argument("--audio", type=Path, metavar="FILE.wav", help="a spoken command: 'hey robot, …'")
     parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
     parser.add_argument("--no-live", action="store_true", help="plain status lines instead of the live tree")
     parser.add_argument("--summary-json", type=Path, help="write the run summary to this JSON file")
@@ -70,8 +71,8 @@ def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> No
 def run_main(argv: list[str] | None = None) -> int:
     parser = _run_parser()
     args = parser.parse_args(argv)
-    if sum((args.mission is not None, args.command is not None, args.interactive)) != 1:
-        parser.error("give a mission file, --command TEXT or --interactive (one of them)")
+    if sum((args.mission is not None, args.command is not None, args.interactive, args.audio is not None)) != 1:
+        parser.error("give a mission file, --command TEXT, --audio FILE.wav or --interactive (one of them)")
     console = Console(soft_wrap=True)
     if args.interactive:
         return _interactive(args, console)
@@ -81,6 +82,8 @@ def run_main(argv: list[str] | None = None) -> int:
 
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
+        if args.audio is not None:
+            args.command = _heard_command(args.audio, args.world, console)
         if args.command is not None:
             outcome = _plan_from_command(args, console)
             if outcome.spec is None:
@@ -233,6 +236,27 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
     threading.Thread(target=read, daemon=True).start()
     session.serve()
     return EXIT_OK
+
+
+def _heard_command(audio: Path, world: str, console: Console) -> str:
+    """The command spoken in a WAV file after the wake word; a UserError if there is none."""
+    from bt_humanoid.language.asr import WAKE_WORD, CommandRecognizer
+    from bt_humanoid.language.audio import read_wav
+    from bt_humanoid.sim.world_config import load_world_config
+
+    if not audio.is_file():
+        raise UserError(f"{audio}: no such file", hint="give a WAV file of a spoken command")
+    try:
+        samples = read_wav(audio)
+    except ValueError as error:
+        raise UserError(str(error)) from None
+    heard = CommandRecognizer(load_world_config(world)).transcribe(samples)
+    console.print(f"[bold]heard:[/] {heard.text or '(nothing I understand)'}", highlight=False)
+    if not heard.woken:
+        raise UserError(f"{audio}: no '{WAKE_WORD}' at the start", hint=f"say '{WAKE_WORD}, …' and then the command")
+    if not heard.command:
+        raise UserError(f"{audio}: '{WAKE_WORD}' but no command after it")
+    return heard.command
 
 
 def _plan_parser() -> argparse.ArgumentParser:

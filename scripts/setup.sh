@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Set up bt-humanoid on a fresh Debian machine: system libraries for off-screen
-# rendering (Mesa EGL), then a virtual environment in .venv with the package,
+# rendering (Mesa EGL) and speech (espeak-ng), then a virtual environment in .venv with the package,
 # its test tools and every Python dependency. Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-debian_packages=(libegl1 libegl-mesa0 libgl1-mesa-dri)
+debian_packages=(libegl1 libegl-mesa0 libgl1-mesa-dri espeak-ng)
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg -s "$package" >/dev/null 2>&1 || missing+=("$package")

@@ -1,0 +1,111 @@
+"""Offline speech recognition: pocketsphinx with a grammar of the robot's commands in this world.
+
+Free dictation with pocketsphinx's general language model is poor on short
+commands (see NOTES.md); a JSGF grammar of what the planner understands,
+filled with the world's own words (its objects, colours, places and
+surfaces), decodes them reliably and fast. An utterance may start with the
+wake word ("hey robot"); the transcript keeps it so callers can tell.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bt_humanoid.language.audio import RATE
+from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
+from bt_humanoid.sim.world_config import WorldConfig
+
+WAKE_WORD = "hey robot"
+PADDING = 0.2  # s of silence around an utterance
+NUMBERS = (  # what distances, angles and counts are spoken as
+    "one | two | three | four | five | six | seven | eight | nine | ten | fifteen | twenty | thirty | forty"
+    " | forty five | fifty | sixty | seventy | eighty | ninety | one hundred | one hundred and eighty | half a"
+)
+
+
+@dataclass
+class Transcript:
+    text: str  # what was heard, lower case; empty if nothing fitted the grammar
+    seconds: float  # wall time the decoding took
+
+    @property
+    def woken(self) -> bool:
+        return self.text.startswith(WAKE_WORD)
+
+    @property
+    def command(self) -> str:
+        """The words after the wake word."""
+        return self.text[len(WAKE_WORD) :].strip() if self.woken else self.text
+
+
+def command_grammar(world: WorldConfig) -> str:
+    """A JSGF grammar of the commands the embedded planner understands, in this world's words."""
+    names = sorted(world.objects)
+    kinds = sorted({w for w in KIND_WORDS if not w.endswith("s")} | {"thing"})
+    plurals = sorted(w for w in KIND_WORDS if w.endswith("s") and w[:-1] in KIND_WORDS)
+    colours = sorted(c for c in COLOURS if c != "gray")
+    places = sorted(p.replace("_", " ") for p in world.places if p != "start")
+    surfaces = sorted(world.surfaces)
+    rule = " | ".join
+    return "\n".join(
+        [
+            "#JSGF V1.0;",
+            "grammar robot;",
+            f"public <utterance> = [{WAKE_WORD}] <command>;",
+            "<command> = <clause> [[and] [then] <clause> [[and] [then] <clause>]];",  # up to three steps
+            "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>;",
+            "<take> = (pick up | grab | take | get | lift) <object> | pick <object> up;",
+            "<put> = (put | place | set) <thing> (on | onto) <surface>;",
+            "<bring> = (bring | fetch | give | hand) me <object>"
+            " | (bring | take | carry | move) <thing> to (me | <surface>);",
+            "<go> = (go | walk | drive | head | navigate) to <place> | go home | come here | come to me;",
+            "<step> = (walk | go | move | drive) (forward | back | backward) [<number> (meters | meter)];",
+            "<turn> = (turn | rotate) (left | right) [<number> degrees] | turn around | face <place>;",
+            "<find> = (find | where is | look for) <object>;",
+            "<wave> = wave [<number> times];",
+            "<stop> = stop | halt | freeze;",
+            "<say> = say (hello | goodbye | done | thank you);",
+            "<thing> = <object> | it | them | all the <plural> | both <plural>;",
+            "<object> = the <description> | something to (drink | play with);",
+            "<description> = [<colour>] <kind> [(on | from) <surface>] [in <place>] | <name>"
+            " | (biggest | smallest) thing;",
+            f"<name> = {rule(names)};",
+            f"<kind> = {rule(kinds)};",
+            f"<plural> = {rule(plurals)};",
+            f"<colour> = {rule(colours)};",
+            f"<surface> = the ({rule(surfaces)});",
+            f"<place> = the ({rule(places)}) | the {rule(surfaces)};",
+            f"<number> = {NUMBERS};",
+            "",
+        ]
+    )
+
+
+class CommandRecognizer:
+    """Decodes whole utterances (16 kHz mono samples) against the command grammar of a world."""
+
+    def __init__(self, world: WorldConfig) -> None:
+        from pocketsphinx import Decoder, set_loglevel
+
+        set_loglevel("FATAL")
+        self._folder = tempfile.TemporaryDirectory()
+        grammar = Path(self._folder.name) / "commands.gram"
+        grammar.write_text(command_grammar(world))
+        self.decoder = Decoder(jsgf=str(grammar), samprate=RATE, dither=True)  # synthetic silence is exact zeros
+
+    def transcribe(self, samples: np.ndarray) -> Transcript:
+        started = time.perf_counter()
+        decoder = self.decoder
+        quiet = np.zeros(int(PADDING * RATE), dtype=np.int16)  # room before and after: the last word is not cut
+        audio = np.concatenate([quiet, np.asarray(samples, dtype=np.int16), quiet])
+        decoder.start_utt()
+        decoder.process_raw(audio.tobytes(), full_utt=True)
+        decoder.end_utt()
+        hypothesis = decoder.hyp()
+        text = " ".join(hypothesis.hypstr.split()) if hypothesis is not None else ""
+        return Transcript(text, time.perf_counter() - started)
