@@ -25,6 +25,7 @@ PADDING = 0.2  # s of silence around an utterance
 NUMBERS = (  # what distances, angles and counts are spoken as
     "one | two | three | four | five | six | seven | eight | nine | ten | fifteen | twenty | thirty | forty"
     " | forty five | fifty | sixty | seventy | eighty | ninety | one hundred | one hundred and eighty | half a"
+    " | one point five | two point five"
 )
 
 
@@ -56,20 +57,22 @@ def command_grammar(world: WorldConfig) -> str:
         [
             "#JSGF V1.0;",
             "grammar robot;",
-            f"public <utterance> = [{WAKE_WORD}] <command>;",
-            "<command> = <clause> [[and] [then] <clause> [[and] [then] <clause>]];",  # up to three steps
+            f"public <utterance> = [{WAKE_WORD}] [<polite>] <command> [please] [now];",
+            "<polite> = please | could you | can you | would you;",
+            "<command> = <clause> [[and] [then] <clause> [[and] [then] <clause>]];  // up to three steps",
             "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>;",
-            "<take> = (pick up | grab | take | get | lift) <object> | pick <object> up;",
-            "<put> = (put | place | set) <thing> (on | onto) <surface>;",
-            "<bring> = (bring | fetch | give | hand) me <object>"
-            " | (bring | take | carry | move) <thing> to (me | <surface>);",
-            "<go> = (go | walk | drive | head | navigate) to <place> | go home | come here | come to me;",
+            "<take> = (pick up | grab | take | get | lift | collect) <object> | pick <object> up;",
+            "<put> = (put | place | set) <thing> [down] (on | onto) <surface> | (move | take | carry) <thing> [over] to"
+            " <surface>;",
+            "<bring> = (bring | fetch | give | hand | get) me <object> | (bring | take | carry) <thing> to me;",
+            "<go> = (go | walk | drive | head | navigate) [over] to (<place> | <object>) | go home | come here"
+            " | come to me;",
             "<step> = (walk | go | move | drive) (forward | back | backward) [<number> (meters | meter)];",
             "<turn> = (turn | rotate) (left | right) [<number> degrees] | turn around | face <place>;",
             "<find> = (find | where is | look for) <object>;",
             "<wave> = wave [<number> times];",
             "<stop> = stop | halt | freeze;",
-            "<say> = say (hello | goodbye | done | thank you);",
+            "<say> = say (hello [everyone] | goodbye | done | thank you);",
             "<thing> = <object> | it | them | all the <plural> | both <plural>;",
             "<object> = the <description> | something to (drink | play with);",
             "<description> = [<colour>] <kind> [(on | from) <surface>] [in <place>] | <name>"
@@ -78,12 +81,30 @@ def command_grammar(world: WorldConfig) -> str:
             f"<kind> = {rule(kinds)};",
             f"<plural> = {rule(plurals)};",
             f"<colour> = {rule(colours)};",
-            f"<surface> = the ({rule(surfaces)});",
-            f"<place> = the ({rule(places)}) | the {rule(surfaces)};",
+            f"<surface> = the [kitchen | dining] ({rule(surfaces)});",
+            f"<place> = the ({rule(places)}) | <surface>;",
             f"<number> = {NUMBERS};",
             "",
         ]
     )
+
+
+def speech_span(samples: np.ndarray, frame: float = 0.01, margin: float = 0.15) -> np.ndarray:
+    """The samples from the first to the last loud frame (4× the quietest frames' power), with a margin.
+
+    Noise before and after a command is where a grammar decoder invents words; cutting it also saves time.
+    """
+    size = int(frame * RATE)
+    count = len(samples) // size
+    if count < 10:
+        return samples
+    power = (samples[: count * size].astype(float).reshape(count, size) ** 2).mean(axis=1)
+    loud = np.nonzero(power > 4.0 * max(np.percentile(power, 10), 1.0))[0]
+    if len(loud) == 0:
+        return samples
+    keep = int(margin / frame)
+    first, last = max(loud[0] - keep, 0), min(loud[-1] + keep + 1, count)
+    return samples[first * size : last * size]
 
 
 class CommandRecognizer:
@@ -102,7 +123,7 @@ class CommandRecognizer:
         started = time.perf_counter()
         decoder = self.decoder
         quiet = np.zeros(int(PADDING * RATE), dtype=np.int16)  # room before and after: the last word is not cut
-        audio = np.concatenate([quiet, np.asarray(samples, dtype=np.int16), quiet])
+        audio = np.concatenate([quiet, speech_span(np.asarray(samples, dtype=np.int16)), quiet])
         decoder.start_utt()
         decoder.process_raw(audio.tobytes(), full_utt=True)
         decoder.end_utt()
