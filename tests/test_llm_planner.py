@@ -8,16 +8,13 @@ import json
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
-import numpy as np
 import pytest
 
 from bt_humanoid.cli import EXIT_OK, plan_main
 from bt_humanoid.commanding import make_planner
 from bt_humanoid.language.llm import LlmSettings, PlanCache, world_summary
 from bt_humanoid.language.plan import PlanningContext, mission_signature
-from bt_humanoid.sim.world_config import load_world_config
-from bt_humanoid.testing.scenario import build_run
-from bt_humanoid.testing.told import tell_object_poses
+from bt_humanoid.testing.told import told_planning_context
 
 GOOD = {"kind": "mission", "say": "I will fetch the mug.", "tree": {"take": {"object": "coffee mug"}}}
 UNKNOWN_SKILL = {"kind": "mission", "say": "Backflip!", "tree": {"backflip": {"height": 2}}}
@@ -67,9 +64,7 @@ def model():
 
 @pytest.fixture(scope="module")
 def context() -> PlanningContext:
-    run = build_run({"mission": "listen", "tree": {"wait": {"seconds": 0}}})
-    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
-    return PlanningContext(load_world_config("apartment"), run.context.world_model, np.zeros(3))
+    return told_planning_context("apartment")
 
 
 def _planner(model, repairs: int = 2):

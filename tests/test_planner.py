@@ -7,36 +7,22 @@ import pytest
 import yaml
 
 from bt_humanoid.language.embedded import EmbeddedPlanner, split_clauses
-from bt_humanoid.language.plan import PlanningContext, mission_signature
+from bt_humanoid.language.plan import PlanningContext, mission_signature, plan_outcome
 from bt_humanoid.language.words import normalise
 from bt_humanoid.mission.loader import MissionLoader
-from bt_humanoid.sim.world_config import load_world_config
-from bt_humanoid.testing.scenario import build_run
-from bt_humanoid.testing.told import tell_object_poses
+from bt_humanoid.testing.told import told_planning_context
 
 COMMANDS = yaml.safe_load((Path(__file__).parent / "data" / "commands.yaml").read_text())
 
 
 @pytest.fixture(scope="module")
 def context() -> PlanningContext:
-    run = build_run({"mission": "listen", "tree": {"wait": {"seconds": 0}}})
-    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)  # language, not detection
-    return PlanningContext(load_world_config("apartment"), run.context.world_model, np.zeros(3))
+    return told_planning_context("apartment")  # language, not detection: the objects are told
 
 
 @pytest.fixture(scope="module")
 def planner() -> EmbeddedPlanner:
     return EmbeddedPlanner()
-
-
-def _outcome(plan) -> dict:
-    if plan.kind == "mission":
-        return {"plan": mission_signature(plan.mission["tree"])}
-    if plan.kind == "question":
-        return {"asks": plan.choice.options}
-    if plan.kind == "refusal":
-        return {"refuses": True}
-    return {"stop": True}
 
 
 def test_the_command_set_is_big_and_varied():
@@ -48,7 +34,7 @@ def test_planner_accuracy_on_the_command_set(planner, context):
     wrong = {}
     for command in COMMANDS:
         expected = {k: v for k, v in command.items() if k != "text"}
-        got = _outcome(planner.plan(command["text"], context))
+        got = plan_outcome(planner.plan(command["text"], context))
         if got != expected:
             wrong[command["text"]] = got
     accuracy = 1 - len(wrong) / len(COMMANDS)

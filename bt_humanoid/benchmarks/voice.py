@@ -26,38 +26,22 @@ from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args
 from bt_humanoid.language.asr import CommandRecognizer
 from bt_humanoid.language.audio import RATE, spoken, with_noise
 from bt_humanoid.language.embedded import EmbeddedPlanner
-from bt_humanoid.language.plan import PlanningContext, mission_signature
+from bt_humanoid.language.plan import plan_outcome
 from bt_humanoid.language.words import normalise
 from bt_humanoid.paths import project_root
-from bt_humanoid.sim.world_config import load_world_config
-from bt_humanoid.testing.scenario import build_run
-from bt_humanoid.testing.told import tell_object_poses
+from bt_humanoid.testing.told import told_planning_context
 
 VOICES = ("en-us", "en-gb")
 SPEEDS = (140, 210)  # words a minute: 175 ± 20 %
 SNR_DB = 20.0
 
 
-def outcome(plan) -> dict:
-    """What a plan amounts to, in the command set's terms."""
-    if plan.kind == "mission":
-        return {"plan": mission_signature(plan.mission["tree"])}
-    if plan.kind == "question":
-        return {"asks": plan.choice.options}
-    if plan.kind == "refusal":
-        return {"refuses": True}
-    return {"stop": True}
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = benchmark_parser(__doc__, "repeats", 1, "noise draws per command, voice and speed")
     args = parse_benchmark_args(parser, argv, "repeats")
     commands = yaml.safe_load((project_root() / "tests" / "data" / "commands.yaml").read_text())
-    world = load_world_config("apartment")
-    run = build_run({"mission": "listen", "tree": {"wait": {"seconds": 0}}})
-    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)  # language, not detection
-    context = PlanningContext(world, run.context.world_model, np.zeros(3))
-    recognizer = CommandRecognizer(world)
+    context = told_planning_context("apartment")  # language, not detection: the objects are told
+    recognizer = CommandRecognizer(context.world)
     planner = EmbeddedPlanner()
     planner.plan("bring me something to drink", context)  # the sentence embeddings load once
     rng = np.random.default_rng(args.seed)
@@ -78,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
                     latencies.append(heard.seconds)
                     if 2.5 <= len(clean) / RATE <= 3.5:
                         three_seconds.append(heard.seconds)
-                    got = outcome(planner.plan(heard.command or "(nothing heard)", context))
+                    got = plan_outcome(planner.plan(heard.command or "(nothing heard)", context))
                     correct += got == expected
                     verbatim += heard.command == normalise(command["text"]).replace(",", "").replace("  ", " ")
                     if got != expected:

@@ -39,6 +39,17 @@ class Plan:
     planning_time: float = 0.0  # s of wall time from text to this plan
 
 
+def plan_outcome(plan: Plan) -> dict[str, Any]:
+    """What a plan amounts to, as tests/data/commands.yaml writes it: plan steps, asks, refuses or stop."""
+    if plan.kind == "mission" and plan.mission is not None:
+        return {"plan": mission_signature(plan.mission["tree"])}
+    if plan.kind == "question" and plan.choice is not None:
+        return {"asks": plan.choice.options}
+    if plan.kind == "refusal":
+        return {"refuses": True}
+    return {"stop": True}
+
+
 @dataclass
 class PlanningContext:
     """What a planner may read: the world's names and map, the robot's belief and where it stands."""

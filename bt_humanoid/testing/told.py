@@ -12,7 +12,9 @@ from __future__ import annotations
 import math
 
 import mujoco
+import numpy as np
 
+from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.perception.world_model import TrackedObject, WorldModel
 from bt_humanoid.sim.geometry import object_extents, rotation_of
 from bt_humanoid.sim.world_config import WorldConfig
@@ -44,3 +46,14 @@ def tell_object_poses(belief: WorldModel, world: WorldConfig, model: mujoco.MjMo
     """Put every declared object into ``belief`` where the model puts it."""
     for tracked in told_objects(world, model):
         belief.update(tracked)
+
+
+def told_planning_context(world: str = "apartment") -> PlanningContext:
+    """A planner's view of ``world`` with every declared object told, from its start pose: language, not sight."""
+    from bt_humanoid.testing.scenario import build_run
+
+    run = build_run({"mission": "listen", "world": world, "tree": {"wait": {"seconds": 0}}})
+    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
+    if run.perceiver is not None:
+        run.perceiver.close()
+    return PlanningContext(run.context.world, run.context.world_model, np.zeros(3))
