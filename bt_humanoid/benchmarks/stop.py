@@ -3,7 +3,7 @@
     python -m bt_humanoid.benchmarks.stop --trials 25
 
 Each trial runs one of several missions planned from commands (drive to the
-kitchen, walk forward, turn around, wave, pick up the red cube) and, at a
+kitchen or the living room, turn around, wave, pick up the red cube) and, at a
 random moment while the robot moves faster than 5 cm/s, delivers "stop" the
 way the terminal does: it is planned (the planner answers "stop") and the
 run's stop request is raised. Latency is simulation time from that moment to
@@ -28,9 +28,9 @@ from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.sim.world_config import load_world_config
 
-COMMANDS = (
+COMMANDS = (  # from the start pose; walking straight ahead would meet the storage box (move_base does not steer)
     "go to the kitchen",
-    "walk forward three meters",
+    "go to the living room",
     "turn around",
     "wave three times",
     "pick up the red cube",

@@ -49,6 +49,9 @@ class JointReferenceController:
         self.velocity = np.zeros(len(self.joints))
         self.acceleration = np.zeros(len(self.joints))
         self.goals: list[_Goal] = []
+        # fingers squeeze what they hold by pressing past it: braking them to where they are would let go
+        fingers = [j for gripper in config.grippers.values() for j in gripper.joints]
+        self._arm_like = np.array([j not in fingers for j in self.joints])
 
     def indices(self, joints: list[str]) -> np.ndarray:
         return np.array([self.io.index(j) for j in joints], dtype=int)
@@ -78,13 +81,18 @@ class JointReferenceController:
         """Cancel goals and bring references (all, or ``joints``) to rest as fast as the limits allow."""
         idx = np.arange(len(self.joints)) if joints is None else joints
         self._preempt(idx, "halted: braking")
-        moving = idx[np.abs(self.velocity[idx]) + np.abs(self.acceleration[idx]) > 1e-9]
+        speed = np.abs(self.io.velocities())
+        commanded = np.abs(self.velocity[idx]) + np.abs(self.acceleration[idx]) > 1e-9
+        moving = idx[commanded | (self._arm_like[idx] & (speed[idx] > 1e-3))]
         if len(moving) == 0:
             return
+        # from where the joints are, not where their references were: a lagging joint then stops where it is
+        # instead of catching up with a reference that stopped ahead of it (fingers keep their reference)
+        measured = self._arm_like[moving]
         trajectory = plan_trajectory(
-            self.position[moving],
-            self.velocity[moving],
-            self.acceleration[moving],
+            np.where(measured, self.io.positions()[moving], self.position[moving]),
+            np.where(measured, self.io.velocities()[moving], self.velocity[moving]),
+            np.where(measured, 0.0, self.acceleration[moving]),
             None,
             tuple(limit[moving] * scale for limit, scale in zip(self.limits, BRAKE_SCALE, strict=True)),
             brake=True,
