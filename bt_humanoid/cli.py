@@ -46,6 +46,8 @@ def _run_parser() -> argparse.ArgumentParser:
         "--interactive", action="store_true", help="type commands (and answers, and 'stop') one after another"
     )
     parser.add_argument("--audio", type=Path, metavar="FILE.wav", help="a spoken command: 'hey robot, …'")
+    parser.add_argument("--speak", action="store_true", help="say things aloud through the speaker (espeak-ng)")
+    parser.add_argument("--speech-wav", type=Path, metavar="DIR", help="also write everything said as WAV files here")
     parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
     parser.add_argument("--no-live", action="store_true", help="plain status lines instead of the live tree")
     parser.add_argument("--summary-json", type=Path, help="write the run summary to this JSON file")
@@ -91,7 +93,7 @@ def run_main(argv: list[str] | None = None) -> int:
             spec = outcome.spec
         else:
             spec = MissionLoader().load_file(args.mission)
-        run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz)
+        run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz, speak=_speech_out(args))
         recorder = None
         if args.record:
             from bt_humanoid.viz.recorder import VideoRecorder
@@ -236,6 +238,19 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
     threading.Thread(target=read, daemon=True).start()
     session.serve()
     return EXIT_OK
+
+
+def _speech_out(args: argparse.Namespace):
+    """espeak-ng for what the robot says, when asked for (--speak, --speech-wav); None: printed only."""
+    if not (args.speak or args.speech_wav):
+        return None
+    from bt_humanoid.language.audio import SpeechOut, espeak_available
+
+    if not espeak_available():
+        raise UserError(
+            "--speak and --speech-wav need espeak-ng", hint="apt-get install espeak-ng, or run scripts/setup.sh"
+        )
+    return SpeechOut(speaker=args.speak, folder=args.speech_wav)
 
 
 def _heard_command(audio: Path, world: str, console: Console) -> str:

@@ -8,6 +8,7 @@ import pytest
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, run_main
 from bt_humanoid.language.asr import CommandRecognizer, command_grammar
 from bt_humanoid.language.audio import espeak_available, read_wav, spoken, synthesize, write_wav
+from bt_humanoid.paths import project_root
 from bt_humanoid.sim.world_config import load_world_config
 
 
@@ -52,3 +53,15 @@ def test_bt_run_audio_without_the_wake_word_is_refused_with_exit_2(tmp_path, cap
     wav = synthesize("put the red cube on the counter", tmp_path / "command.wav")
     assert run_main(["--audio", str(wav), "--no-live"]) == EXIT_INVALID
     assert "no 'hey robot' at the start" in capsys.readouterr().err
+
+
+def test_what_the_robot_says_is_spoken_into_wav_files(tmp_path, capsys):
+    speech = tmp_path / "speech"
+    demo = project_root() / "missions" / "demo.yaml"
+    assert run_main([str(demo), "--no-live", "--speech-wav", str(speech)]) == EXIT_OK
+    files = sorted(speech.glob("*.wav"))
+    said = [line for line in capsys.readouterr().out.splitlines() if "said" in line]
+    assert len(files) == len(said) == 2  # "Heading to the table." and "Ready at the table."
+    for file in files:
+        samples = read_wav(file)
+        assert len(samples) > 0.5 * 16000 and abs(samples).max() > 1000  # a second or so of speech, not silence

@@ -75,3 +75,28 @@ def with_noise(samples: np.ndarray, snr_db: float, rng: np.random.Generator) -> 
     power = float(np.mean(active**2)) if len(active) else 0.0
     noise = rng.normal(0.0, np.sqrt(power / 10 ** (snr_db / 10)), size=len(speech))
     return np.clip(speech + noise, -32768, 32767).astype(np.int16)
+
+
+class SpeechOut:
+    """What the robot says, spoken with espeak-ng: through the speaker, into numbered WAV files, or both.
+
+    Speaking never holds up the robot: playback runs in the background. Without espeak-ng it does nothing
+    (the run still prints what is said).
+    """
+
+    def __init__(self, speaker: bool = False, folder: Path | None = None, voice: str = "en-us") -> None:
+        self.speaker = speaker and espeak_available()
+        self.folder = folder
+        self.voice = voice
+        self.files: list[Path] = []
+        if folder is not None:
+            folder.mkdir(parents=True, exist_ok=True)
+
+    def __call__(self, text: str) -> None:
+        if not espeak_available():
+            return
+        if self.folder is not None:
+            path = self.folder / f"{len(self.files) + 1:03d}.wav"
+            self.files.append(synthesize(text, path, self.voice))
+        if self.speaker:
+            subprocess.Popen(["espeak-ng", "-v", self.voice, text], stderr=subprocess.DEVNULL)
