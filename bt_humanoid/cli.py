@@ -174,8 +174,7 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
     """Plan ``--command``; print what the robot says and the mission; ask questions of ``--answer`` or the user."""
     import yaml
 
-    from bt_humanoid.commanding import context_at_start, make_planner, plan_command
-    from bt_humanoid.language.llm import LlmSettings
+    from bt_humanoid.commanding import context_at_start, plan_command
 
     if not args.command.strip():
         raise UserError("--command is empty", hint='say what to do, e.g. --command "pick up the red cube"')
@@ -190,13 +189,9 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
             console.print(f"[bold]you:[/] {reply}", highlight=False)
         return reply
 
-    settings = LlmSettings.from_environment(args.llm_url, args.llm_model, args.llm_key)
-    if (args.llm_url or args.llm_model) and settings is None:
-        raise UserError(
-            "--llm-url and --llm-model go together", hint="give both, or set BT_LLM_BASE_URL and BT_LLM_MODEL"
-        )
+    planner = _planner(args)
     context = context_at_start(args.world, args.robot)
-    outcome = plan_command(args.command, context, answer, make_planner(settings))
+    outcome = plan_command(args.command, context, answer, planner)
     plan = outcome.plan
     if plan.kind == "mission":
         console.print(f"[bold]robot:[/] {plan.say}", highlight=False)
@@ -211,13 +206,24 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
     return outcome
 
 
+def _planner(args: argparse.Namespace):
+    """The embedded planner, or an LLM one when --llm-url and --llm-model (or their variables) are given."""
+    from bt_humanoid.commanding import make_planner
+    from bt_humanoid.language.llm import LlmSettings
+
+    settings = LlmSettings.from_environment(args.llm_url, args.llm_model, args.llm_key)
+    if (args.llm_url or args.llm_model) and settings is None:
+        hint = "give both, or set BT_LLM_BASE_URL and BT_LLM_MODEL"
+        raise UserError("--llm-url and --llm-model go together", hint=hint)
+    return make_planner(settings)
+
+
 def _interactive(args: argparse.Namespace, console: Console) -> int:
     """Read commands from the terminal until end of input; the robot works on one simulation throughout."""
     import queue
     import threading
 
-    from bt_humanoid.commanding import InteractiveSession, make_planner
-    from bt_humanoid.language.llm import LlmSettings
+    from bt_humanoid.commanding import InteractiveSession
 
     lines: queue.Queue[str | None] = queue.Queue()
 
@@ -226,12 +232,15 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
             lines.put(line.rstrip("\n"))
         lines.put(None)
 
-    def say(text: str) -> None:
-        console.print(f"[bold]robot:[/] {text}", highlight=False)
-
     try:
-        settings = LlmSettings.from_environment(args.llm_url, args.llm_model, args.llm_key)
-        session = InteractiveSession(args.world, args.robot, lines, say, make_planner(settings))
+        speech = _speech_out(args)
+
+        def say(text: str) -> None:
+            console.print(f"[bold]robot:[/] {text}", highlight=False)
+            if speech is not None:
+                speech(text)
+
+        session = InteractiveSession(args.world, args.robot, lines, say, _planner(args))
     except UserError as error:
         return _fail_invalid(error)
     say("Ready. Tell me what to do; 'stop' stops me; end with Ctrl-D.")

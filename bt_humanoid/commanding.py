@@ -22,14 +22,13 @@ from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.perception.grounding import resolve
 
-MAX_QUESTIONS = 3  # a command still unclear after this many answers is refused
+MAX_QUESTIONS = 3  # answers taken per command; still unclear after them, the question stands and nothing runs
 
 
 @dataclass
 class CommandOutcome:
     plan: Plan  # the last answer of the planner
     spec: MissionSpec | None  # the validated mission, when there is one to run
-    dialogue: list[tuple[str, str]]  # (robot, person) turns of questions and answers
 
 
 def context_at_start(world: str, robot: str) -> PlanningContext:
@@ -81,29 +80,31 @@ def _world_problems(node: Any, context: PlanningContext, path: str = "tree"):
     (x0, y0), (x1, y1) = context.world.bounds
     for key, value in node.items():
         where = f"{path}.{key}"
-        if key == "object" and isinstance(value, str) and not value.startswith("$"):
-            if value not in context.world.objects:
-                try:
-                    resolve(value, context.belief, context.robot_pose)
-                except KeyError as error:
-                    names = ", ".join(context.world.objects)
-                    yield f"{where}: unknown object {value!r} ({error.args[0]}); known objects: {names}"
-        elif (
-            key == "pose"
-            and isinstance(value, list)
-            and len(value) >= 2
-            and all(isinstance(v, int | float) for v in value[:2])
-        ):
-            if not (x0 <= value[0] <= x1 and y0 <= value[1] <= y1):
-                yield f"{where}: ({value[0]}, {value[1]}) is outside the map [{x0}, {x1}] × [{y0}, {y1}]"
-        elif key == "move_base" and isinstance(value, dict):
-            x, y = value.get("x"), value.get("y")
-            if value.get("relative"):
-                if isinstance(x, int | float) and abs(x) > MAX_STEP:
-                    yield f"{where}.x: a relative move of {x} m; at most {MAX_STEP:.0f} m (use navigate)"
-            elif isinstance(x, int | float) and isinstance(y, int | float) and not (x0 <= x <= x1 and y0 <= y <= y1):
-                yield f"{where}: ({x}, {y}) is outside the map [{x0}, {x1}] × [{y0}, {y1}]"
+        named = key == "object" and isinstance(value, str) and not value.startswith("$")
+        if named and value not in context.world.objects:
+            try:
+                resolve(value, context.belief, context.robot_pose)
+            except KeyError as error:
+                names = ", ".join(context.world.objects)
+                yield f"{where}: unknown object {value!r} ({error.args[0]}); known objects: {names}"
+        goal = _goal_xy(key, value)
+        if goal is not None and not (x0 <= goal[0] <= x1 and y0 <= goal[1] <= y1):
+            yield f"{where}: ({goal[0]}, {goal[1]}) is outside the map [{x0}, {x1}] × [{y0}, {y1}]"
+        step = value.get("x") if key == "move_base" and isinstance(value, dict) and value.get("relative") else None
+        if isinstance(step, int | float) and abs(step) > MAX_STEP:
+            yield f"{where}.x: a relative move of {step} m; at most {MAX_STEP:.0f} m (use navigate)"
         yield from _world_problems(value, context, where)
+
+
+def _goal_xy(key: str, value: Any) -> tuple[float, float] | None:
+    """The world x, y a node's parameter sends the robot to: a pose, or an absolute move_base."""
+    if key == "pose" and isinstance(value, list) and len(value) >= 2:
+        x, y = value[0], value[1]
+    elif key == "move_base" and isinstance(value, dict) and not value.get("relative"):
+        x, y = value.get("x"), value.get("y")
+    else:
+        return None
+    return (x, y) if isinstance(x, int | float) and isinstance(y, int | float) else None
 
 
 def plan_command(
@@ -115,17 +116,17 @@ def plan_command(
     """Plan ``text``; each question goes to ``answers`` (None: no answer, the question stands)."""
     planner = planner or EmbeddedPlanner()
     plan = planner.plan(text, context)
-    dialogue: list[tuple[str, str]] = []
-    while plan.kind == "question" and plan.choice is not None and len(dialogue) < MAX_QUESTIONS:
+    for _ in range(MAX_QUESTIONS):
+        if plan.kind != "question" or plan.choice is None:
+            break
         reply = answers(plan.say)
         if reply is None:
             break
-        dialogue.append((plan.say, reply))
         plan = planner.answer(plan.choice, reply, context)
     spec = None
     if plan.kind == "mission" and plan.mission is not None:
         spec = MissionLoader().load_data(plan.mission, name="<command>")
-    return CommandOutcome(plan, spec, dialogue)
+    return CommandOutcome(plan, spec)
 
 
 class InteractiveSession:

@@ -112,10 +112,3 @@ def test_a_second_verb_starts_a_clause_even_without_and_as_speech_recognition_gi
         "put it on the counter",
     ]
     assert split_clauses("say pick up your toys") == ["say pick up your toys"]  # what is said stays whole
-
-
-def test_embedded_planning_is_fast_once_models_are_loaded(planner, context):
-    planner.plan("bring me something to drink", context)  # loads the sentence embeddings once
-    times = [planner.plan(c["text"], context).planning_time for c in COMMANDS]
-    print(f"embedded plan latency: median {np.median(times) * 1000:.1f} ms")
-    assert np.median(times) < 0.5  # generous here; the benchmark measures it against the 50 ms target

@@ -21,12 +21,11 @@ import time
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
+from bt_humanoid.commanding import context_at_start
 from bt_humanoid.engine.runner import MissionRun
-from bt_humanoid.language.embedded import EmbeddedPlanner
+from bt_humanoid.language.embedded import EmbeddedPlanner, is_stop
 from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
-from bt_humanoid.perception.map_knowledge import map_world_model
-from bt_humanoid.sim.world_config import load_world_config
 
 COMMANDS = (  # from the start pose; walking straight ahead would meet the storage box (move_base does not steer)
     "go to the kitchen",
@@ -36,19 +35,12 @@ COMMANDS = (  # from the start pose; walking straight ahead would meet the stora
     "pick up the red cube",
 )
 MOVING = 0.05  # m/s (or rad/s): the robot counts as in motion above this
-AT_REST = 0.01  # m/s (or rad/s): every speed below this is rest
 EARLIEST = 1.0  # s of simulation before a stop may come
 
 
-def stop_trial(command: str, rng: np.random.Generator) -> tuple[float, float] | None:
+def stop_trial(command: str, context: PlanningContext, rng: np.random.Generator) -> tuple[float, float] | None:
     """(latency s, speed when stopped) for one run of ``command`` stopped at a random moving moment."""
-    world = load_world_config("apartment")
-    planner = EmbeddedPlanner()
-    probe = {"mission": "probe", "tree": {"wait": {"seconds": 0}}}
-    run = MissionRun(MissionLoader().load_data(probe))
-    context = PlanningContext(world, map_world_model(world, run.sim.model), run.robot.base.pose())
-    run.perceiver and run.perceiver.close()
-    plan = planner.plan(command, context)
+    plan = EmbeddedPlanner().plan(command, context)
     run = MissionRun(MissionLoader().load_data(plan.mission))
     stop_after = EARLIEST + float(rng.uniform(0.0, 3.0))
     state: dict[str, float] = {}
@@ -56,10 +48,10 @@ def stop_trial(command: str, rng: np.random.Generator) -> tuple[float, float] | 
     def watch() -> None:
         now, speed = run.sim.time, run.robot.max_speed()
         if "stopped" not in state and now >= stop_after and speed > MOVING:
-            if planner.plan("stop", context).kind == "stop":  # what the terminal does with a typed "stop"
+            if is_stop("stop"):  # what the terminal does with a typed line
                 run.request_stop("stop (typed)")
                 state["stopped"], state["speed"] = now, speed
-        elif "stopped" in state and "rest" not in state and speed < AT_REST:
+        elif "stopped" in state and "rest" not in state and run.robot.at_rest():
             state["rest"] = now
 
     run.executor.observers.append(watch)
@@ -73,6 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = benchmark_parser(__doc__, "trials", 25, "stopped runs")
     args = parse_benchmark_args(parser, argv, "trials")
     rng = np.random.default_rng(args.seed)
+    context = context_at_start("apartment", "wheeled_humanoid")  # what bt-run --command plans with
     print(f"bt-humanoid stop benchmark: {args.trials} stops in mid-motion, seed {args.seed} (one core)")
     started = time.perf_counter()
     latencies: list[float] = []
@@ -80,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     missed = 0
     for index in range(args.trials):
         command = COMMANDS[index % len(COMMANDS)]
-        outcome = stop_trial(command, rng)
+        outcome = stop_trial(command, context, rng)
         if outcome is None:
             missed += 1
             print(f"  {index + 1}/{args.trials} {command!r}: no stop in mid-motion (finished first or kept moving)")

@@ -81,9 +81,9 @@ class JointReferenceController:
         """Cancel goals and bring references (all, or ``joints``) to rest as fast as the limits allow."""
         idx = np.arange(len(self.joints)) if joints is None else joints
         self._preempt(idx, "halted: braking")
-        speed = np.abs(self.io.velocities())
+        velocities = self.io.velocities()
         commanded = np.abs(self.velocity[idx]) + np.abs(self.acceleration[idx]) > 1e-9
-        moving = idx[commanded | (self._arm_like[idx] & (speed[idx] > 1e-3))]
+        moving = idx[commanded | (self._arm_like[idx] & (np.abs(velocities[idx]) > 1e-3))]
         if len(moving) == 0:
             return
         # from where the joints are, not where their references were: a lagging joint then stops where it is
@@ -91,7 +91,7 @@ class JointReferenceController:
         measured = self._arm_like[moving]
         trajectory = plan_trajectory(
             np.where(measured, self.io.positions()[moving], self.position[moving]),
-            np.where(measured, self.io.velocities()[moving], self.velocity[moving]),
+            np.where(measured, velocities[moving], self.velocity[moving]),
             np.where(measured, 0.0, self.acceleration[moving]),
             None,
             tuple(limit[moving] * scale for limit, scale in zip(self.limits, BRAKE_SCALE, strict=True)),

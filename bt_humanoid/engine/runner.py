@@ -21,7 +21,6 @@ from bt_humanoid.mission.success import ConditionResult, check_condition
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import Perceiver
-from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.simulation import Simulation
@@ -84,8 +83,6 @@ class MissionRun:
         self.robot.planners.append(self.navigator)
         self.truth = GroundTruth(self.sim)
         self.said: list[str] = []
-        safety = header.safety
-        defaults = robot_config.safety
 
         def say(text: str) -> None:
             self.said.append(text)
@@ -100,10 +97,10 @@ class MissionRun:
             joint_ranges=known.joint_ranges,
             robot=self.robot,
             clock=lambda: self.sim.time,
-            max_base_speed=min(safety.max_base_speed or defaults.max_base_speed, defaults.max_base_speed),
-            blackboard=Blackboard(header.blackboard),  # both set again per mission by _prepare
+            max_base_speed=0.0,  # per mission: set by _prepare
+            blackboard=Blackboard({}),  # per mission: set by _prepare
             speak=say,
-            world_model=self.initial_world_model(),
+            world_model=map_world_model(world, self.sim.model),  # its map, and no objects until the camera sees them
             navigator=self.navigator,
         )
         self.perceiver: Perceiver | None = None
@@ -148,10 +145,6 @@ class MissionRun:
                 f"this run is {self.spec.header.world}/{self.spec.header.robot}"
             )
         self._prepare(spec)
-
-    def initial_world_model(self) -> WorldModel:
-        """What the robot knows at the start: its map (surfaces, people, names of things) and no objects yet."""
-        return map_world_model(self.spec.known.world, self.sim.model)
 
     def request_stop(self, reason: str = "stop requested") -> None:
         """Stop now: every motion starts braking at once; the tree is halted at its next tick."""

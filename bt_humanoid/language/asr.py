@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 
 from bt_humanoid.language.audio import RATE
+from bt_humanoid.language.words import WAKE_WORDS
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
 from bt_humanoid.sim.world_config import WorldConfig
 
-WAKE_WORD = "hey robot"
+WAKE_WORD = WAKE_WORDS[0]  # "hey robot": the one the grammar listens for
 PADDING = 0.2  # s of silence around an utterance
 NUMBERS = (  # what distances, angles and counts are spoken as
     "one | two | three | four | five | six | seven | eight | nine | ten | fifteen | twenty | thirty | forty"

@@ -33,7 +33,7 @@ import numpy as np
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
 from bt_humanoid.language.words import normalise
 from bt_humanoid.perception.free_space import free_spot
-from bt_humanoid.perception.grounding import KIND_WORDS, describes_an_object, ground
+from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS, describes_an_object, ground
 from bt_humanoid.perception.world_model import TrackedObject
 
 ABILITIES = (
@@ -44,6 +44,7 @@ DEFAULT_TURN = 90.0  # degrees for "turn left" without a number
 DEFAULT_STEP = 1.0  # m for "walk forward" without a number
 MAX_STEP = 5.0  # m: a longer relative move is a job for "go to"
 PERSON_WORDS = {"me", "us", "the user", "user", "the person", "person", "here"}
+PLACE_ALIASES = {"home": "start", "dining table": "table", "kitchen counter": "counter", "shelves": "shelf"}
 CLAUSE_BREAK = re.compile(r"\s*(?:,\s*)?(?:\band then\b|\bthen\b|\bafter that\b|\band\b|,)\s*")
 ARTICLE = re.compile(r"^(?:the|a|an|some|my|your|that|this)\s+")
 
@@ -84,7 +85,7 @@ PATTERNS: list[tuple[str, re.Pattern[str]]] = [
             r"(?:over\s+)?(?:to|onto|over to|into|back to)\s+(?P<where>.+)$"  # "on the table" says where it is
         ),
     ),
-    ("bring_here", re.compile(r"^(?:bring|fetch)\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
+    ("bring_me", re.compile(r"^(?:bring|fetch)\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
     (
         "put",
         re.compile(
@@ -166,7 +167,7 @@ class EmbeddedPlanner:
             "tree": tree,
         }
         summary = "I will " + _join(state.lines) + "."
-        return Plan("mission", summary, mission=mission, steps=state.lines, planning_time=time.perf_counter() - started)
+        return Plan("mission", summary, mission=mission, planning_time=time.perf_counter() - started)
 
     def answer(self, choice: Choice, reply: str, context: PlanningContext) -> Plan:
         """Continue a command after a question: the reply picks one of the choice's options."""
@@ -242,12 +243,9 @@ class EmbeddedPlanner:
             self._take(target, state)
             self._give(state, context)
 
-    def _bring_here(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        self._bring_me(match, state, context)
-
     def _bring_to(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         where = _bare(match["where"])
-        if where in PERSON_WORDS or where in _people(context):
+        if where in PERSON_WORDS or where in context.world.person_names:
             self._bring_me(match, state, context)
             return
         self._put_on(match["what"], match["where"], state, context)
@@ -264,7 +262,7 @@ class EmbeddedPlanner:
 
     def _go(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         where = _bare(match["where"])
-        if where in PERSON_WORDS or where in _people(context):
+        if where in PERSON_WORDS or where in context.world.person_names:
             self._go_to_person(state, context)
             return
         place = _place_name(where, context)
@@ -328,9 +326,7 @@ class EmbeddedPlanner:
 
     def _put_on(self, what: str, where: str, state: _State, context: PlanningContext) -> None:
         surface_name = _bare(where)
-        surface_name = {"kitchen counter": "counter", "dining table": "table", "shelves": "shelf"}.get(
-            surface_name, surface_name
-        )
+        surface_name = PLACE_ALIASES.get(surface_name, surface_name)
         if surface_name not in context.world.surfaces:
             surfaces = ", the ".join(context.world.surfaces)
             raise PlanRefused(f"I can't put things on '{surface_name}'. I can put them on the {surfaces}.")
@@ -376,7 +372,7 @@ class EmbeddedPlanner:
         bare = _bare(phrase)
         if bare in ("it", "that", "this"):
             return self._objects(bare, state, context)[0]
-        if bare in PERSON_WORDS or bare in _people(context):
+        if bare in PERSON_WORDS or bare in context.world.person_names:
             raise PlanRefused("I can't pick up people.")
         if bare in context.world.surfaces or _place_name(bare, context) is not None:
             examples = ", the ".join(list(context.world.objects)[:3])
@@ -401,8 +397,8 @@ class EmbeddedPlanner:
     def _all(self, phrase: str, context: PlanningContext) -> list[str]:
         words = re.findall(r"[a-z]+", phrase)
         kinds = {KIND_WORDS[w] for w in words if w in KIND_WORDS}
-        colours = {w for w in words if w in {o.colour for o in context.belief.objects.values()}}
-        present = [o for o in context.belief.objects.values() if o.confidence > 0.0 or o.held_by is not None]
+        colours = {w for w in words if w in COLOURS}  # "all the purple cubes" are none, not every cube
+        present = context.belief.present()
         chosen = [
             o
             for o in present
@@ -523,17 +519,12 @@ def _place_name(words: str, context: PlanningContext) -> str | None:
     key = words.replace(" ", "_")
     if key in context.world.places:
         return key
-    aliases = {"home": "start", "dining table": "table", "kitchen counter": "counter", "shelves": "shelf"}
-    alias = aliases.get(words)
+    alias = PLACE_ALIASES.get(words)
     return alias if alias in context.world.places else None
 
 
 def _spoken(name: str) -> str:
     return name.replace("_", " ")
-
-
-def _people(context: PlanningContext) -> set[str]:
-    return {n for name, person in context.world.people.items() for n in (name, *person.aliases)}
 
 
 def _name_of(tracked: TrackedObject, context: PlanningContext) -> str:
@@ -559,7 +550,7 @@ def _by_vocabulary(words: str, context: PlanningContext) -> list[str]:
         if kinds and declared.kind not in kinds:
             continue
         if any(w in tokens for w in name.split()) or declared.kind in kinds:
-            colour_words = tokens & {"red", "blue", "green", "yellow", "white", "black", "grey", "orange", "purple"}
+            colour_words = tokens & COLOURS
             if colour_words and declared.colour not in colour_words:
                 continue
             fitting.append(name)
@@ -571,7 +562,7 @@ def _which(options: list[str]) -> str:
 
 
 def _not_seen(phrase: str, context: PlanningContext) -> str:
-    seen = sorted({_name_of(o, context) for o in context.belief.objects.values() if o.confidence > 0.0})
+    seen = sorted({_name_of(o, context) for o in context.belief.present()})
     article = "an" if phrase[:1] in "aeiou" else "a"
     what = f" I see the {_join(seen)}." if seen else " I have not seen anything yet."
     return f"I don't see {article} {phrase}.{what}"

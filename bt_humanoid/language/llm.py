@@ -112,7 +112,6 @@ class LlmPlanner:
         self.validate = validate  # answer tree → mission (raises PlanRejected)
         self.fallback = fallback
         self.cache = cache if cache is not None else PlanCache()
-        self.calls = 0  # requests sent to the endpoint
         self.last_problems: list[str] = []  # what was wrong with each rejected answer of the last command
 
     def plan(self, text: str, context: PlanningContext) -> Plan:
@@ -179,7 +178,6 @@ class LlmPlanner:
         request = urllib.request.Request(
             f"{self.settings.base_url}/chat/completions", json.dumps(body).encode(), headers, method="POST"
         )
-        self.calls += 1
         with urllib.request.urlopen(request, timeout=self.settings.timeout) as response:
             reply = json.loads(response.read().decode())
         try:
@@ -233,9 +231,7 @@ def _parse(content: str) -> dict[str, Any]:
 def world_summary(context: PlanningContext) -> str:
     """What the robot knows, as compact JSON: the prompt's world section and part of the cache key."""
     world, belief = context.world, context.belief
-    seen = sorted(
-        (o for o in belief.objects.values() if o.confidence > 0.0 or o.held_by is not None), key=lambda o: o.id
-    )
+    seen = sorted(belief.present(), key=lambda o: o.id)
 
     def surface_of(position: np.ndarray) -> str | None:
         surface = belief.surface_under(position)

@@ -9,7 +9,7 @@ continues the same command.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -35,7 +35,6 @@ class Plan:
     say: str  # what the robot says: what it will do, the question, or why not
     mission: dict[str, Any] | None = None
     choice: Choice | None = None  # for a question
-    steps: list[str] = field(default_factory=list)  # one line per step, for people
     planning_time: float = 0.0  # s of wall time from text to this plan
 
 

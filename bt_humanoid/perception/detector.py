@@ -129,6 +129,8 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     # shape cues that one oblique view gives reliably: the silhouette's width across the line of sight, how much
     # of the object is its flat top and how full that top's outline is, and how well a sphere fits the points
     width = _extent(points[:, :2], _across(points[:, :2], eye))
+    if width < MIN_WIDTH:
+        return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
     flatness = float(np.mean(heights > top - FLAT_BAND))
     # a flat top as wide as the thing is its lid, and outlines its body (a bottle's cap is narrower)
     lid = len(flat_top) >= WELL_SEEN_TOP and _circle(flat_top)[1] > LID_WIDTH * width
@@ -136,8 +138,6 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     if len(points) < HANDLE_VIEW:
         handle = None  # a few pixels of outline do not show a handle reliably
     yaw_known = True
-    if width < MIN_WIDTH:
-        return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
     ball = _resting_sphere(points, surface.height, top)
     if ball is not None:  # first: a ball half hidden looks narrow and tall
         kind = "ball"
@@ -162,7 +162,7 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
             yaw = math.atan2(handle[1], handle[0])
         else:  # a mug whose handle is not seen has it behind, pointing away from the camera
             sight = centre - eye[:2]
-            yaw, yaw_known = math.atan2(sight[1], sight[0]), kind not in ("mug",)
+            yaw, yaw_known = math.atan2(sight[1], sight[0]), kind != "mug"
     position = np.array([centre[0], centre[1], surface.height + top / 2])
     colour = colour_name(_best_lit(colours))
     return Detection(kind, colour, position, size, yaw, surface.name, len(points), yaw_known)

@@ -34,7 +34,7 @@ def free_spot(
         candidates = np.column_stack([xs, np.full(len(xs), y)])
     if len(candidates) == 0:
         return None
-    taken = [o.position[:2] for o in belief.objects.values() if o.confidence > 0.0 and o.held_by is None]
+    taken = [o.position[:2] for o in belief.present() if o.held_by is None]
     taken += list(also_taken or [])
     if taken:
         nearest = np.min(np.linalg.norm(candidates[:, None, :] - np.array(taken)[None, :, :], axis=2), axis=1)

@@ -103,7 +103,7 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
     ``viewer`` (x, y, yaw: the robot) is where "left of" and "right of" are seen from.
     """
     text = phrase.lower().strip()
-    present = [o for o in belief.objects.values() if o.confidence > 0.0 or o.held_by is not None]
+    present = belief.present()
     if not present:
         return Grounding(phrase, message=f"I do not see anything yet, so not {phrase!r}")
     relative = RELATIVE.search(text)

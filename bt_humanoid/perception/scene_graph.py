@@ -27,7 +27,7 @@ class Relation:
 
 def scene_graph(belief: WorldModel, viewer: np.ndarray | None = None) -> list[Relation]:
     """Every relation that holds now between the believed objects (and the surfaces they stand on)."""
-    present = [o for o in belief.objects.values() if o.confidence > 0.0 and o.held_by is None]
+    present = [o for o in belief.present() if o.held_by is None]
     facts = []
     for a in present:
         surface = belief.surface_under(a.position)

@@ -76,7 +76,7 @@ class WorldModel:
         """
         if name in self.objects:
             return self.objects[name]
-        present = [o for o in self.objects.values() if o.confidence > 0.0 or o.held_by is not None]
+        present = self.present()
         named = [o for o in present if o.name == name]
         if not named and name in self.vocabulary:
             kind, colour = self.vocabulary[name]
@@ -93,6 +93,10 @@ class WorldModel:
             raise KeyError(f"I have not seen the {name}{what} yet")
         known = [o.name for o in present]
         raise KeyError(f"no object {name!r} in the world model; {did_you_mean(name, known)}")
+
+    def present(self) -> list[TrackedObject]:
+        """The objects believed to be there now: seen and not since missed, or in a hand."""
+        return [o for o in self.objects.values() if o.confidence > 0.0 or o.held_by is not None]
 
     def surface(self, name: str) -> SupportSurface:
         if name not in self.surfaces:

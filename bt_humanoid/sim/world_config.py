@@ -65,6 +65,11 @@ class WorldConfig(StrictModel):
     def model_path(self) -> Path:
         return self.folder / self.model
 
+    @property
+    def person_names(self) -> list[str]:
+        """Every name a person answers to: their own and their aliases ("me", "user")."""
+        return [n for name, person in self.people.items() for n in (name, *person.aliases)]
+
     def place(self, name: str) -> Place:
         if name not in self.places:
             raise UserError(f"unknown place '{name}' in world '{self.name}'", hint=did_you_mean(name, self.places))

@@ -87,8 +87,7 @@ class Give(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: GiveParams, context: CheckContext) -> list[tuple[str, str]]:
-        names = [n for name, person in context.world.people.items() for n in (name, *person.aliases)]
-        return check_name(params.to, names, "to", "person")
+        return check_name(params.to, context.world.person_names, "to", "person")
 
     def phases(self):
         return [

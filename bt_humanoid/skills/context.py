@@ -54,4 +54,4 @@ class SkillContext(CheckContext):
     speak: Callable[[str], None] = print
     world_model: WorldModel = field(default_factory=WorldModel)  # what the robot believes; skills read only this
     navigator: Navigator | None = None  # plans and follows routes for the base
-    perceiver: Perceiver | None = None  # fills the world model from the head camera (missions with perception: camera)
+    perceiver: Perceiver | None = None  # fills the world model from the head camera (robots that have one)

@@ -79,8 +79,7 @@ def _places_and_objects(params: NavigateToParams | TurnParams, context: CheckCon
     problems = check_name(params.place, context.world.places, "place", "place")
     problems += check_object(params.object, context.world)
     if isinstance(params, NavigateToParams):
-        people = [n for name, person in context.world.people.items() for n in (name, *person.aliases)]
-        problems += check_name(params.person, people, "person", "person")
+        problems += check_name(params.person, context.world.person_names, "person", "person")
     return problems
 
 

@@ -4,9 +4,10 @@
 head camera onto it. A phrase that is not a name is grounded
 (``perception/grounding.py``): "the cup on the counter" finds the mug, "the
 cube" asks which one. When the robot has a camera in the loop and does not
-know the object yet, it looks ahead, left and right first. It fails with the
-reason when it still does not know (searching other rooms comes next). The
-found object's id goes to the blackboard (``remember_as``) for later leaves.
+know the object yet, it looks ahead, left and right first, then searches the
+named places, nearest first, looking around at each. It fails with the
+reason when it still does not know. The found object's id goes to the
+blackboard (``remember_as``) for later leaves.
 """
 
 from __future__ import annotations
@@ -48,18 +49,22 @@ class Find(_ManipulationSkill):
             def distance(item) -> float:
                 return float(np.hypot(*(np.array(item[1].pose[:2]) - here)))
 
-            phases.append(("step back to search", self._step_back))
-            phases.append(("fold the arms to search", lambda: None if self.target else tuck_empty_arms(self.context)))
-            phases.append(("lower the torso", lambda: None if self.target else lower_empty_torso(self.context)))
+            phases += [
+                ("step back to search", self._until_found(self._step_back)),
+                ("fold the arms to search", self._until_found(lambda: tuck_empty_arms(self.context))),
+                ("lower the torso", self._until_found(lambda: lower_empty_torso(self.context))),
+            ]
             for name, place in sorted(self.context.world.places.items(), key=distance):
                 phases += [(f"search the {name}", lambda p=place: self._go(p)), *self._look_around(name)]
         return [*phases, ("look at it", self._look_at_it)]
 
+    def _until_found(self, action):
+        """A search phase that does nothing once the object has been found."""
+        return lambda: None if self.target is not None else action()
+
     def _step_back(self) -> MotionHandle | None:
         """Away from a table before folding the arms: a hand over it would hit it on the way down."""
-        if self.target is not None or not at_a_surface(self.context):
-            return None
-        return back_up(self.context, STEP_BACK)
+        return back_up(self.context, STEP_BACK) if at_a_surface(self.context) else None
 
     def _look_around(self, where: str) -> list:
         label = f"look around {where}"
