@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 from rich.console import Console
+from rich.markup import escape
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.paths import missions_dir
@@ -23,7 +24,7 @@ SCHEMA_FILE = "mission.schema.json"
 
 
 def _fail_invalid(error: UserError) -> int:
-    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {error}", markup=True, soft_wrap=True)
+    Console(stderr=True, highlight=False).print(f"[bold red]error:[/] {escape(str(error))}", soft_wrap=True)
     return EXIT_INVALID
 
 
@@ -46,6 +47,13 @@ def _run_parser() -> argparse.ArgumentParser:
         "--interactive", action="store_true", help="type commands (and answers, and 'stop') one after another"
     )
     parser.add_argument("--audio", type=Path, metavar="FILE.wav", help="a spoken command: 'hey robot, …'")
+    parser.add_argument(
+        "--listen",
+        nargs="?",
+        const="microphone",
+        metavar="FILE.wav",
+        help="listen for 'hey robot, …' and 'stop' from the microphone (or a WAV file played as one) while working",
+    )
     parser.add_argument("--speak", action="store_true", help="say things aloud through the speaker (espeak-ng)")
     parser.add_argument("--speech-wav", type=Path, metavar="DIR", help="also write everything said as WAV files here")
     parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
@@ -73,10 +81,11 @@ def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> No
 def run_main(argv: list[str] | None = None) -> int:
     parser = _run_parser()
     args = parser.parse_args(argv)
-    if sum((args.mission is not None, args.command is not None, args.interactive, args.audio is not None)) != 1:
-        parser.error("give a mission file, --command TEXT, --audio FILE.wav or --interactive (one of them)")
+    given = (args.mission is not None, args.command is not None, args.interactive, args.audio, args.listen)
+    if sum(map(bool, given)) != 1:
+        parser.error("give a mission file, --command TEXT, --audio FILE.wav, --interactive or --listen (one of them)")
     console = Console(soft_wrap=True)
-    if args.interactive:
+    if args.interactive or args.listen:
         return _interactive(args, console)
     try:
         from bt_humanoid.engine.runner import MissionRun
@@ -104,14 +113,7 @@ def run_main(argv: list[str] | None = None) -> int:
         return _fail_invalid(error)
 
     if args.realtime:
-        started = time.perf_counter()
-
-        def pace() -> None:
-            ahead = run.sim.time - (time.perf_counter() - started)
-            if ahead > 0:
-                time.sleep(ahead)
-
-        run.executor.observers.append(pace)
+        _pace_to_wall_clock(run)
 
     def on_interrupt(signum: int, frame: object) -> None:
         if run.stop_monitor.reason is not None:
@@ -144,6 +146,18 @@ def run_main(argv: list[str] | None = None) -> int:
     if args.events:
         result.events.write(args.events)
     return EXIT_OK if result.success else EXIT_FAILED
+
+
+def _pace_to_wall_clock(run) -> None:  # a MissionRun (imported late: it loads MuJoCo)
+    """Hold each control step back until the wall clock catches up with simulation time."""
+    started = time.perf_counter() - run.sim.time
+
+    def pace() -> None:
+        ahead = run.sim.time - (time.perf_counter() - started)
+        if ahead > 0:
+            time.sleep(ahead)
+
+    run.executor.observers.append(pace)
 
 
 def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
@@ -219,19 +233,13 @@ def _planner(args: argparse.Namespace):
 
 
 def _interactive(args: argparse.Namespace, console: Console) -> int:
-    """Read commands from the terminal until end of input; the robot works on one simulation throughout."""
+    """Commands typed (--interactive) or spoken (--listen) until they end; the robot works on one simulation."""
     import queue
     import threading
 
     from bt_humanoid.commanding import InteractiveSession
 
     lines: queue.Queue[str | None] = queue.Queue()
-
-    def read() -> None:
-        for line in sys.stdin:
-            lines.put(line.rstrip("\n"))
-        lines.put(None)
-
     try:
         speech = _speech_out(args)
 
@@ -241,12 +249,55 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
                 speech(text)
 
         session = InteractiveSession(args.world, args.robot, lines, say, _planner(args))
+        if args.listen:
+            relay = _listener_thread(args, lines, session, console)
+            _pace_to_wall_clock(session.run)  # spoken words come in real time; so must the robot move
     except UserError as error:
         return _fail_invalid(error)
-    say("Ready. Tell me what to do; 'stop' stops me; end with Ctrl-D.")
-    threading.Thread(target=read, daemon=True).start()
-    session.serve()
+    if args.listen:
+        say(f"Ready. Say '{_wake_word()}, …' and a command; 'stop' stops me.")
+        relay.start()
+    else:
+        say("Ready. Tell me what to do; 'stop' stops me; end with Ctrl-D.")
+        threading.Thread(target=lambda: _read_lines(lines), daemon=True).start()
+    try:
+        session.serve()
+    except KeyboardInterrupt:
+        session.run.request_stop("stop requested (Ctrl-C)")
     return EXIT_OK
+
+
+def _read_lines(lines) -> None:  # a queue.Queue of typed lines
+    for line in sys.stdin:
+        lines.put(line.rstrip("\n"))
+    lines.put(None)
+
+
+def _wake_word() -> str:
+    from bt_humanoid.language.asr import WAKE_WORD
+
+    return WAKE_WORD
+
+
+def _listener_thread(args: argparse.Namespace, lines, session, console: Console):
+    """A thread that listens (microphone or file) and passes what it hears to the session as lines."""
+    import threading
+
+    from bt_humanoid.commanding import relay_heard
+    from bt_humanoid.language.asr import CommandRecognizer
+    from bt_humanoid.language.listening import Listener
+    from bt_humanoid.language.sound_sources import file_blocks, microphone_blocks
+
+    blocks = microphone_blocks() if args.listen == "microphone" else file_blocks(Path(args.listen))
+    listener = Listener(CommandRecognizer(session.run.context.world))
+
+    def show(text: str) -> None:
+        console.print(f"[bold]{text.split(':', 1)[0]}:[/]{text.split(':', 1)[1]}", highlight=False)
+
+    def awaiting() -> bool:
+        return session.awaiting_answer
+
+    return threading.Thread(target=relay_heard, args=(blocks, listener, lines, awaiting, show), daemon=True)
 
 
 def _speech_out(args: argparse.Namespace):

@@ -10,12 +10,16 @@ from __future__ import annotations
 
 import queue
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from bt_humanoid.errors import UserError
+from bt_humanoid.language.asr import WAKE_WORD
 from bt_humanoid.language.embedded import MAX_STEP, EmbeddedPlanner, is_stop
+from bt_humanoid.language.listening import Heard, Listener
 from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
@@ -155,6 +159,7 @@ class InteractiveSession:
         self.run.executor.observers.append(self._listen_while_busy)
         self.results: list[Any] = []
         self.finished = False
+        self.awaiting_answer = False  # a question is out: the next line is its answer
         if self.run.perceiver is not None:
             self.run.perceiver.look()
 
@@ -190,7 +195,11 @@ class InteractiveSession:
 
     def _ask(self, question: str) -> str | None:
         self.say(question)
-        return self._next_line()
+        self.awaiting_answer = True
+        try:
+            return self._next_line()
+        finally:
+            self.awaiting_answer = False
 
     def _next_line(self) -> str | None:
         if self.pending:
@@ -215,3 +224,37 @@ class InteractiveSession:
                 self.run.request_stop("stop (typed)")
             else:
                 self.pending.append(line)
+
+
+def relay_heard(
+    blocks: Iterable[np.ndarray],
+    listener: Listener,
+    lines: queue.Queue[str | None],
+    awaiting_answer: Callable[[], bool],
+    show: Callable[[str], None],
+) -> None:
+    """Pass what the listener hears in ``blocks`` on as lines a person would type; None when the sound ends.
+
+    A stop goes on at once. An utterance goes on when it starts with the wake word ("hey robot, …") or answers
+    a question; anything else was not said to the robot.
+    """
+    for block in blocks:
+        for heard in listener.feed(block):
+            _relay(heard, lines, awaiting_answer, show)
+    for heard in listener.close():
+        _relay(heard, lines, awaiting_answer, show)
+    lines.put(None)
+
+
+def _relay(
+    heard: Heard, lines: queue.Queue[str | None], awaiting_answer: Callable[[], bool], show: Callable[[str], None]
+) -> None:
+    transcript = heard.transcript
+    if heard.kind == "stop":
+        show(f"heard: {heard.text}")
+        lines.put("stop")
+    elif transcript.woken or awaiting_answer():
+        show(f"heard: {heard.text}")
+        lines.put(transcript.command)
+    else:
+        show(f"heard (no '{WAKE_WORD}', not for me): {heard.text}")

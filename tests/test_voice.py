@@ -2,6 +2,7 @@
 
 import json
 import re
+import sys
 import wave
 
 import numpy as np
@@ -125,3 +126,28 @@ def test_noise_alone_is_not_heard_as_anything(recognizer):
     quiet = np.random.default_rng(6).normal(0.0, 30.0, 3 * 16000).astype(np.int16)
     assert _listen(Listener(recognizer), quiet) == []
     assert all(item.kind != "stop" for item in _listen(Listener(recognizer), audio))
+
+
+def test_bt_run_listen_hears_a_command_a_spoken_stop_and_the_next_command(tmp_path, capsys):
+    """A WAV file played as a microphone, in real time: the robot sets off, 'stop' stops it, it waves after."""
+    quiet = lambda seconds: np.zeros(int(seconds * 16000), dtype=np.int16)  # noqa: E731
+    sound = [quiet(0.5), spoken("hey robot, go to the kitchen"), quiet(2.5), spoken("stop"), quiet(1.0)]
+    sound += [spoken("hey robot, wave"), quiet(1.0)]
+    wav = write_wav(tmp_path / "stream.wav", with_noise(np.concatenate(sound), 30.0, np.random.default_rng(0)))
+    assert run_main(["--listen", str(wav)]) == EXIT_OK
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith(("heard", "robot"))]
+    assert said[1:] == [
+        "heard: hey robot go to the kitchen",
+        "robot: I will go to the kitchen.",
+        "heard: stop",
+        "robot: I have stopped.",  # mid-way: the kitchen is more than 2.5 s away
+        "heard: hey robot wave",
+        "robot: I will wave.",
+        "robot: Done.",
+    ]
+
+
+def test_bt_run_listen_without_a_microphone_says_what_to_install(capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "sounddevice", None)  # as if it were not installed
+    assert run_main(["--listen"]) == EXIT_INVALID
+    assert "pip install 'bt-humanoid[microphone]'" in capsys.readouterr().err
