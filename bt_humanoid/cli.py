@@ -54,6 +54,9 @@ def _run_parser() -> argparse.ArgumentParser:
         metavar="FILE.wav",
         help="listen for 'hey robot, …' and 'stop' from the microphone (or a WAV file played as one) while working",
     )
+    parser.add_argument(
+        "--whisper-model", type=Path, metavar="DIR", help="recognise with a local Whisper model (faster-whisper)"
+    )
     parser.add_argument("--speak", action="store_true", help="say things aloud through the speaker (espeak-ng)")
     parser.add_argument("--speech-wav", type=Path, metavar="DIR", help="also write everything said as WAV files here")
     parser.add_argument("--seed", type=int, default=None, help="random seed (default: the mission's)")
@@ -94,7 +97,7 @@ def run_main(argv: list[str] | None = None) -> int:
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
         if args.audio is not None:
-            args.command = _heard_command(args.audio, args.world, console)
+            args.command = _heard_command(args, console)
         if args.command is not None:
             outcome = _plan_from_command(args, console)
             if outcome.spec is None:
@@ -289,7 +292,8 @@ def _listener_thread(args: argparse.Namespace, lines, session, console: Console)
     from bt_humanoid.language.sound_sources import file_blocks, microphone_blocks
 
     blocks = microphone_blocks() if args.listen == "microphone" else file_blocks(Path(args.listen))
-    listener = Listener(CommandRecognizer(session.run.context.world))
+    world = session.run.context.world
+    listener = Listener(CommandRecognizer(world), transcriber=_transcriber(args, world))
 
     def show(text: str) -> None:
         console.print(f"[bold]{text.split(':', 1)[0]}:[/]{text.split(':', 1)[1]}", highlight=False)
@@ -313,19 +317,30 @@ def _speech_out(args: argparse.Namespace):
     return SpeechOut(speaker=args.speak, folder=args.speech_wav)
 
 
-def _heard_command(audio: Path, world: str, console: Console) -> str:
+def _transcriber(args: argparse.Namespace, world):  # world: a WorldConfig
+    """What hears whole utterances: Whisper from --whisper-model, else None (the command grammar decoder)."""
+    if args.whisper_model is None:
+        return None
+    from bt_humanoid.language.whisper_asr import WhisperRecognizer, world_prompt
+
+    return WhisperRecognizer.from_folder(args.whisper_model, world_prompt(world))
+
+
+def _heard_command(args: argparse.Namespace, console: Console) -> str:
     """The command spoken in a WAV file after the wake word; a UserError if there is none."""
     from bt_humanoid.language.asr import WAKE_WORD, CommandRecognizer
     from bt_humanoid.language.audio import read_wav
     from bt_humanoid.sim.world_config import load_world_config
 
+    audio = args.audio
+    world = load_world_config(args.world)
     if not audio.is_file():
         raise UserError(f"{audio}: no such file", hint="give a WAV file of a spoken command")
     try:
         samples = read_wav(audio)
     except ValueError as error:
         raise UserError(str(error)) from None
-    heard = CommandRecognizer(load_world_config(world)).transcribe(samples)
+    heard = (_transcriber(args, world) or CommandRecognizer(world)).transcribe(samples)
     console.print(f"[bold]heard:[/] {heard.text or '(nothing I understand)'}", highlight=False)
     if not heard.woken:
         raise UserError(f"{audio}: no '{WAKE_WORD}' at the start", hint=f"say '{WAKE_WORD}, …' and then the command")

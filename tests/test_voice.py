@@ -12,6 +12,7 @@ from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, run_main
 from bt_humanoid.language.asr import CommandRecognizer, command_grammar
 from bt_humanoid.language.audio import espeak_available, read_wav, spoken, synthesize, with_noise, write_wav
 from bt_humanoid.language.listening import END_SILENCE, Listener
+from bt_humanoid.language.whisper_asr import WhisperRecognizer, world_prompt
 from bt_humanoid.paths import project_root
 from bt_humanoid.sim.world_config import load_world_config
 
@@ -151,3 +152,31 @@ def test_bt_run_listen_without_a_microphone_says_what_to_install(capsys, monkeyp
     monkeypatch.setitem(sys.modules, "sounddevice", None)  # as if it were not installed
     assert run_main(["--listen"]) == EXIT_INVALID
     assert "pip install 'bt-humanoid[microphone]'" in capsys.readouterr().err
+
+
+class _ScriptedWhisper:
+    """Stands in for faster_whisper.WhisperModel: returns fixed segments and records what it was given."""
+
+    def __init__(self, *texts: str) -> None:
+        self.texts = texts
+        self.calls: list[dict] = []
+
+    def transcribe(self, audio, **options):
+        self.calls.append({"audio": audio, **options})
+        return [type("Segment", (), {"text": text})() for text in self.texts], None
+
+
+def test_whisper_text_is_brought_to_the_recognisers_form():
+    model = _ScriptedWhisper(" Hey robot,", " put the red cube on the counter.")
+    whisper = WhisperRecognizer(model, prompt=world_prompt(load_world_config("apartment")))
+    heard = whisper.transcribe(np.full(16000, 16384, dtype=np.int16))
+    assert heard.woken and heard.command == "put the red cube on the counter"
+    call = model.calls[0]
+    assert call["audio"].dtype == np.float32 and abs(call["audio"].max() - 0.5) < 1e-6  # int16 → [-1, 1)
+    assert call["language"] == "en" and "red cube" in call["initial_prompt"]
+
+
+def test_bt_run_whisper_model_that_is_not_there_is_exit_2(tmp_path, capsys):
+    wav = synthesize("hey robot, wave", tmp_path / "command.wav")
+    assert run_main(["--audio", str(wav), "--whisper-model", str(tmp_path / "nowhere")]) == EXIT_INVALID
+    assert "no Whisper model there" in capsys.readouterr().err

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 
@@ -44,6 +44,12 @@ SHORTEST = 0.15  # s of speech an utterance needs (shorter: a click or a breath)
 LONGEST = 12.0  # s: an utterance is cut here (a radio left on must not hold the recogniser forever)
 
 
+class Transcriber(Protocol):
+    """Anything that turns a whole utterance into a Transcript (CommandRecognizer, WhisperRecognizer)."""
+
+    def transcribe(self, samples: np.ndarray) -> Transcript: ...
+
+
 @dataclass(frozen=True)
 class Heard:
     """Something the listener heard: a stop (reported mid-utterance) or a finished utterance."""
@@ -60,10 +66,13 @@ class Heard:
 class Listener:
     """Segments a 16 kHz stream into utterances, decodes them as they come and spots stops early."""
 
-    def __init__(self, recognizer: CommandRecognizer, vad_mode: int | None = None) -> None:
+    def __init__(
+        self, recognizer: CommandRecognizer, vad_mode: int | None = None, transcriber: Transcriber | None = None
+    ) -> None:
         from pocketsphinx import Vad
 
-        self.recognizer = recognizer
+        self.recognizer = recognizer  # decodes as the person speaks, for stops
+        self.transcriber = transcriber or recognizer  # the whole utterance when it ends (Whisper, when given)
         self.vad = Vad(Vad.LOOSE if vad_mode is None else vad_mode, RATE, FRAME)
         self.frame_samples = self.vad.frame_bytes // 2
         self._pending = np.zeros(0, dtype=np.int16)
@@ -151,7 +160,7 @@ class Listener:
 
     def _finish(self) -> list[Heard]:
         self.recognizer.end()  # the running decode was for spotting stops; the whole utterance is decoded again
-        transcript = self.recognizer.transcribe(np.concatenate(self._sound + self._held[: round(TAIL / FRAME)]))
+        transcript = self.transcriber.transcribe(np.concatenate(self._sound + self._held[: round(TAIL / FRAME)]))
         self._in_utterance = False
         self._speech_run = 0
         self._before.clear()
