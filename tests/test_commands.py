@@ -65,7 +65,7 @@ def test_bt_run_needs_a_mission_or_a_command(capsys):
     with pytest.raises(SystemExit) as exit_info:
         run_main([])
     assert exit_info.value.code == EXIT_INVALID
-    assert "give a mission file, --command TEXT, --audio FILE.wav or --interactive" in capsys.readouterr().err
+    assert "give a mission file, --command TEXT, --audio FILE.wav, --interactive or --listen" in capsys.readouterr().err
 
 
 def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
