@@ -1,4 +1,4 @@
-"""The base of every schema model: unknown keys are errors, not silently ignored."""
+"""The base of every schema model: unknown keys are errors, not silently ignored; nan and inf are refused."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from pydantic import BaseModel, ConfigDict
 
 
 class StrictModel(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)  # nan and inf are never a valid quantity
 
 
 def exactly_one(model: BaseModel, *fields: str) -> None:

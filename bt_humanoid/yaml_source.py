@@ -50,7 +50,12 @@ def read_yaml(file: Path, text: str | None = None) -> YamlSource:
             raise UserError("file not found", where=display_path(file)) from None
         except OSError as error:
             raise UserError(f"cannot read: {error.strerror}", where=display_path(file)) from None
-    loader = yaml.SafeLoader(text)
+        except UnicodeDecodeError:
+            raise UserError("not a text file (UTF-8 expected)", where=display_path(file)) from None
+    try:
+        loader = yaml.SafeLoader(text)  # checks the characters first: control characters are refused here
+    except yaml.YAMLError as error:
+        raise UserError(f"YAML error: {error}", where=display_path(file)) from None
     try:
         root = loader.get_single_node()
         source = YamlSource(file, None)
@@ -63,6 +68,8 @@ def read_yaml(file: Path, text: str | None = None) -> YamlSource:
         raise UserError(f"YAML syntax error: {problem}", where=f"{display_path(file)}:{line}") from None
     except yaml.YAMLError as error:
         raise UserError(f"YAML error: {error}", where=display_path(file)) from None
+    except RecursionError:
+        raise UserError("nested too deeply to read", where=display_path(file)) from None
     finally:
         loader.dispose()
 

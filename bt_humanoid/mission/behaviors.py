@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
+from pydantic import BaseModel, Field, ValidationError, create_model
 
 from bt_humanoid.errors import UserError, describe_validation_error
 from bt_humanoid.paths import behaviors_dir
@@ -56,7 +56,7 @@ def _args_model(name: str, header: BehaviorHeader) -> type[BaseModel]:
         else:
             optional = kind if spec.default is not None or kind is Any else kind | None
             fields[param] = (optional, Field(spec.default, description=spec.description))
-    return create_model(f"{name}_args", __config__=ConfigDict(extra="forbid"), __doc__=header.description, **fields)
+    return create_model(f"{name}_args", __config__=StrictModel.model_config, __doc__=header.description, **fields)
 
 
 def load_behavior(file: Path) -> Behavior:

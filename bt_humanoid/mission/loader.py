@@ -64,6 +64,9 @@ def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: 
         raise _first_error(first_only, source, path, prefix) from None
 
 
+MAX_TREE_DEPTH = 64  # levels of nodes: far beyond any real mission, well inside Python's recursion limit
+
+
 class MissionLoader:
     """Loads missions against the skill registry, a behaviour library and the named robot and world."""
 
@@ -108,6 +111,8 @@ class MissionLoader:
 
     def _node(self, raw: Any, source: YamlSource, ypath: YamlPath, path: str, stack: tuple[str, ...]) -> NodeSpec:
         where = source.where(ypath)
+        if len(ypath) > 2 * MAX_TREE_DEPTH:  # each level adds a kind key and an index or a parameter name
+            raise UserError(f"the tree is nested more than {MAX_TREE_DEPTH} levels deep", where=where)
         if not isinstance(raw, dict) or not raw:
             raise UserError(
                 f"a tree node is a mapping with one kind key (a composite, decorator, skill or behaviour), "
@@ -223,7 +228,10 @@ class MissionLoader:
             raise UserError(f"subtrees nested deeper than {MAX_SUBTREE_DEPTH}", where=call_source.where(bpath))
         tree = substitute(behavior_source.data["tree"], args, behavior_source, ("tree",))
         expanded = YamlSource(behavior_source.file, {"tree": tree}, behavior_source.lines)
-        root = self._node(tree, expanded, ("tree",), f"{node_path}>", (*stack, name))
+        try:
+            root = self._node(tree, expanded, ("tree",), f"{node_path}>", (*stack, name))
+        except UserError as error:  # e.g. an argument refused where the behaviour passes it on: name the call too
+            raise UserError(f"in behaviour {name}: {error}", where=call_source.where(bpath)) from None
         return spec(category="behavior", children=[root])
 
     # --- header checks against the world -------------------------------------------

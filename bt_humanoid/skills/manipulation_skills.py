@@ -21,7 +21,7 @@ from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Lim
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.skills.context import CheckContext
-from bt_humanoid.skills.params import check_name, check_object
+from bt_humanoid.skills.params import check_in_map, check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel, exactly_one
@@ -103,7 +103,8 @@ class StandNear(_ManipulationSkill):
     @classmethod
     def check(cls, params: StandNearParams, context: CheckContext) -> list[tuple[str, str]]:
         world = context.world
-        return check_object(params.object, world) + check_name(params.surface, world.surfaces, "surface", "surface")
+        named = check_object(params.object, world) + check_name(params.surface, world.surfaces, "surface", "surface")
+        return named + check_in_map(params.at, world)
 
     def phases(self):
         return [
@@ -287,7 +288,8 @@ class Put(_ManipulationSkill):
 
     @classmethod
     def check(cls, params: PutParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.surface, context.world.surfaces, "surface", "surface")
+        world = context.world
+        return check_name(params.surface, world.surfaces, "surface", "surface") + check_in_map(params.at, world)
 
     def phases(self):
         return [
