@@ -116,7 +116,7 @@ def test_find_grounds_a_phrase_and_remembers_the_object():
 
 
 def test_find_asks_which_one_when_the_phrase_fits_two():
-    _, result = _find("the cube", robot_start=(2.0, 0.0, 0.0))  # west of the table, both cubes in view
+    _, result = _find("the cube", robot_start=(2.15, 0.0, 0.0))  # west of the table (clear of the box): both cubes
     assert result.tree_status == "FAILURE"
     assert "which one do you mean: the red cube or the blue cube?" in result.cause
 

@@ -1,7 +1,8 @@
-"""Safety guards: a stop request, joint limits and the time budget halt the tree and the robot comes to rest."""
+"""Safety guards: a stop request, joint limits, the time budget and the bumper halt the tree; the robot rests."""
 
 from py_trees.common import Status
 
+from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.testing.scenario import build_run
 
 DRIVE = {
@@ -62,3 +63,28 @@ def test_safety_failures_are_not_retried():
     result = build_run(mission).execute()
     waits = [e for e in result.events.events if e["event"] == "status" and e["node"] == "wait"]
     assert [e["new"] for e in waits] == ["RUNNING", "INVALID"]
+
+
+def test_driving_into_furniture_is_stopped_at_the_first_touch():
+    """A relative move does not steer: straight ahead from the start is the storage box. The bumper stops it."""
+    run = build_run({"mission": "blind", "tree": {"move_base": {"x": 3.0, "y": 0.0, "relative": True}}})
+    truth = GroundTruth(run.sim)
+    result = run.execute()
+    assert result.tree_status == "FAILURE"
+    assert result.safety.startswith("collision: the robot's base")
+    x, _, _ = run.robot.base.pose()
+    assert 0.5 < x < 1.5  # stopped at the box (about 1.1 m ahead), not driven through or past it
+    assert run.robot.at_rest()
+    contacts = [pair for pair in truth.robot_contacts() if not pair[0].startswith(("l_", "r_"))]
+    assert len(contacts) <= 4  # resting against it, not pushing into it
+
+
+def test_the_arms_may_touch_what_they_work_on():
+    from bt_humanoid.engine.runner import MissionRun
+    from bt_humanoid.mission.loader import MissionLoader
+    from bt_humanoid.paths import missions_dir
+
+    run = MissionRun(MissionLoader().load_file(missions_dir() / "pick_and_place.yaml"))
+    result = run.execute()
+    assert result.success, result.cause or result.safety
+    assert result.safety is None

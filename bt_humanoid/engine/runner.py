@@ -21,7 +21,14 @@ from bt_humanoid.mission.success import ConditionResult, check_condition
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import Perceiver
-from bt_humanoid.safety.monitors import JointLimitMonitor, SafetySupervisor, StopRequestMonitor, TimeBudgetMonitor
+from bt_humanoid.safety.monitors import (
+    BumperMonitor,
+    JointLimitMonitor,
+    SafetySupervisor,
+    StopRequestMonitor,
+    TimeBudgetMonitor,
+    trunk_bodies,
+)
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.skills.base import Skill
@@ -125,6 +132,7 @@ class MissionRun:
             self.stop_monitor,
             JointLimitMonitor(self.robot, margin),
             TimeBudgetMonitor(self.time_budget, self.sim.time),
+            BumperMonitor(self.sim.model, self.sim.data, self._trunk()),
         ]
         self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time)
 
@@ -135,6 +143,12 @@ class MissionRun:
         observers = self.executor.observers if hasattr(self, "executor") else []
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
         self.executor.observers.extend(observers)
+
+    def _trunk(self) -> set[int]:
+        """The robot's bodies that are not on an arm: what the bumper monitor watches."""
+        model = self.sim.model
+        hands = [int(model.jnt_bodyid[model.joint(j).id]) for g in self.sim.robot.grippers.values() for j in g.joints]
+        return trunk_bodies(model, int(model.body_rootid[hands[0]]), hands) if hands else set()
 
     def follow_with(self, spec: MissionSpec) -> None:
         """Make ``spec`` the next mission, from where the last one left the robot and the world (and the belief)."""

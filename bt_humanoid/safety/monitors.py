@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
+import mujoco
 import numpy as np
 
 from bt_humanoid.control.robot import RobotController
@@ -63,6 +64,49 @@ class JointLimitMonitor:
             return None
         i = int(bad[0])
         return f"joint {self.io.joints[i]} at {q[i]:.3f} outside [{self.lower[i]:.3f}, {self.upper[i]:.3f}]"
+
+
+class BumperMonitor:
+    """Fires when the robot's trunk (base, torso, head: not the arms) touches anything but the floor.
+
+    The arms touch tables and objects as their work; the trunk never should. This is the robot's own touch
+    sense (a bumper and skin), read from the contacts its geoms make; it does not say what was hit.
+    """
+
+    name = "collision"
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, trunk: set[int]) -> None:
+        self.model, self.data = model, data
+        self.trunk = trunk  # body ids
+        self.floor = {g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE}
+
+    def check(self, now: float) -> str | None:
+        model = self.model
+        for contact in self.data.contact[: self.data.ncon]:
+            g1, g2 = int(contact.geom1), int(contact.geom2)
+            for mine, other in ((g1, g2), (g2, g1)):
+                touched = model.geom_bodyid[other] not in self.trunk and other not in self.floor
+                if model.geom_bodyid[mine] in self.trunk and touched:
+                    x, y = contact.pos[:2]
+                    part = model.geom(mine).name or model.body(model.geom_bodyid[mine]).name
+                    return f"the robot's {part} touched something at ({x:.2f}, {y:.2f})"
+        return None
+
+
+def trunk_bodies(model: mujoco.MjModel, root: int, hand_bodies: list[int]) -> set[int]:
+    """The bodies of the robot under ``root`` that are not on an arm (the chain from a hand to the trunk)."""
+    parent = model.body_parentid
+
+    def ancestors(body: int) -> list[int]:
+        chain = [body]
+        while chain[-1] not in (root, 0):
+            chain.append(int(parent[chain[-1]]))
+        return chain
+
+    robot = {b for b in range(model.nbody) if root in ancestors(b)}
+    shared = set.intersection(*(set(ancestors(h)) for h in hand_bodies)) if hand_bodies else set()
+    arm_roots = {next(b for b in reversed(ancestors(h)) if b not in shared) for h in hand_bodies}
+    return {b for b in robot if not arm_roots & set(ancestors(b))}
 
 
 class TimeBudgetMonitor:
