@@ -153,6 +153,7 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
     if not placed:
         failures = [e for e in result.events.events if e["event"] == "status" and e["new"] == "FAILURE"]
         failure = next((e.get("feedback") for e in failures if e.get("feedback")), result.tree_status)
+        failure = f"safety stop: {result.safety}" if result.safety else failure  # which monitor fired, and why
         if result.tree_status == "SUCCESS":
             failure = f"ended {error * 100:.1f} cm from the spot" + ("" if upright else ", tipped over")
     return Outcome(
