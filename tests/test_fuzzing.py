@@ -3,7 +3,7 @@
 Every generated mission is one of the repository's missions with one thing
 broken that no valid mission can have: an unknown node kind, an unknown
 parameter, a mapping where a parameter's value goes, a number beyond every
-limit (or not a number: nan, inf), a header damaged, or the file replaced by
+limit (or not a number: nan, inf, true), a header damaged, or the file replaced by
 arbitrary text. The tool must answer each with exit 2 and a single line that
 names the file, never a traceback.
 
@@ -81,7 +81,7 @@ def broken_missions(draw: st.DrawFn) -> tuple[str, str]:
     elif how == "number" and any(isinstance(v, int | float) for p in leaves for v in p.values()):
         params = draw(st.sampled_from([p for p in leaves if any(isinstance(v, int | float) for v in p.values())]))
         key = draw(st.sampled_from(sorted(k for k, v in params.items() if isinstance(v, int | float))))
-        params[key] = draw(st.sampled_from([math.nan, math.inf, -math.inf, 1e300, -1e300, 10**40, -(10**40)]))
+        params[key] = draw(st.sampled_from([math.nan, math.inf, -math.inf, 1e300, -1e300, 10**40, -(10**40), True]))
     elif how == "header":
         key = draw(st.sampled_from(["tree", "mission", "world", "robot", "extra"]))
         if key == "tree":

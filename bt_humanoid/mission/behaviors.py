@@ -56,7 +56,7 @@ def _args_model(name: str, header: BehaviorHeader) -> type[BaseModel]:
         else:
             optional = kind if spec.default is not None or kind is Any else kind | None
             fields[param] = (optional, Field(spec.default, description=spec.description))
-    return create_model(f"{name}_args", __config__=StrictModel.model_config, __doc__=header.description, **fields)
+    return create_model(f"{name}_args", __base__=StrictModel, __doc__=header.description, **fields)
 
 
 def load_behavior(file: Path) -> Behavior:
