@@ -258,7 +258,9 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
     except UserError as error:
         return _fail_invalid(error)
     if args.listen:
-        say(f"Ready. Say '{_wake_word()}, …' and a command; 'stop' stops me.")
+        from bt_humanoid.language.words import WAKE_WORDS
+
+        say(f"Ready. Say '{WAKE_WORDS[0]}, …' and a command; 'stop' stops me.")
         relay.start()
     else:
         say("Ready. Tell me what to do; 'stop' stops me; end with Ctrl-D.")
@@ -276,12 +278,6 @@ def _read_lines(lines) -> None:  # a queue.Queue of typed lines
     lines.put(None)
 
 
-def _wake_word() -> str:
-    from bt_humanoid.language.asr import WAKE_WORD
-
-    return WAKE_WORD
-
-
 def _listener_thread(args: argparse.Namespace, lines, session, console: Console):
     """A thread that listens (microphone or file) and passes what it hears to the session as lines."""
     import threading
@@ -295,8 +291,8 @@ def _listener_thread(args: argparse.Namespace, lines, session, console: Console)
     world = session.run.context.world
     listener = Listener(CommandRecognizer(world), transcriber=_transcriber(args, world))
 
-    def show(text: str) -> None:
-        console.print(f"[bold]{text.split(':', 1)[0]}:[/]{text.split(':', 1)[1]}", highlight=False)
+    def show(label: str, words: str) -> None:
+        console.print(f"[bold]{escape(label)}:[/] {escape(words)}", highlight=False)
 
     def awaiting() -> bool:
         return session.awaiting_answer
@@ -329,17 +325,12 @@ def _transcriber(args: argparse.Namespace, world):  # world: a WorldConfig
 def _heard_command(args: argparse.Namespace, console: Console) -> str:
     """The command spoken in a WAV file after the wake word; a UserError if there is none."""
     from bt_humanoid.language.asr import WAKE_WORD, CommandRecognizer
-    from bt_humanoid.language.audio import read_wav
+    from bt_humanoid.language.sound_sources import wav_samples
     from bt_humanoid.sim.world_config import load_world_config
 
     audio = args.audio
     world = load_world_config(args.world)
-    if not audio.is_file():
-        raise UserError(f"{audio}: no such file", hint="give a WAV file of a spoken command")
-    try:
-        samples = read_wav(audio)
-    except ValueError as error:
-        raise UserError(str(error)) from None
+    samples = wav_samples(audio, "give a WAV file of a spoken command")
     heard = (_transcriber(args, world) or CommandRecognizer(world)).transcribe(samples)
     console.print(f"[bold]heard:[/] {heard.text or '(nothing I understand)'}", highlight=False)
     if not heard.woken:

@@ -19,7 +19,7 @@ import numpy as np
 from bt_humanoid.errors import UserError
 from bt_humanoid.language.asr import WAKE_WORD
 from bt_humanoid.language.embedded import MAX_STEP, EmbeddedPlanner, is_stop
-from bt_humanoid.language.listening import Heard, Listener
+from bt_humanoid.language.listening import Listener, heard_in
 from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
@@ -81,7 +81,6 @@ def _world_problems(node: Any, context: PlanningContext, path: str = "tree"):
         return
     if not isinstance(node, dict):
         return
-    (x0, y0), (x1, y1) = context.world.bounds
     for key, value in node.items():
         where = f"{path}.{key}"
         named = key == "object" and isinstance(value, str) and not value.startswith("$")
@@ -92,8 +91,9 @@ def _world_problems(node: Any, context: PlanningContext, path: str = "tree"):
                 names = ", ".join(context.world.objects)
                 yield f"{where}: unknown object {value!r} ({error.args[0]}); known objects: {names}"
         goal = _goal_xy(key, value)
-        if goal is not None and not (x0 <= goal[0] <= x1 and y0 <= goal[1] <= y1):
-            yield f"{where}: ({goal[0]}, {goal[1]}) is outside the map [{x0}, {x1}] × [{y0}, {y1}]"
+        problem = context.world.outside_map(*goal) if goal is not None else None
+        if problem:
+            yield f"{where}: {problem}"
         step = value.get("x") if key == "move_base" and isinstance(value, dict) and value.get("relative") else None
         if isinstance(step, int | float) and abs(step) > MAX_STEP:
             yield f"{where}.x: a relative move of {step} m; at most {MAX_STEP:.0f} m (use navigate)"
@@ -231,30 +231,21 @@ def relay_heard(
     listener: Listener,
     lines: queue.Queue[str | None],
     awaiting_answer: Callable[[], bool],
-    show: Callable[[str], None],
+    show: Callable[[str, str], None],
 ) -> None:
     """Pass what the listener hears in ``blocks`` on as lines a person would type; None when the sound ends.
 
     A stop goes on at once. An utterance goes on when it starts with the wake word ("hey robot, …") or answers
-    a question; anything else was not said to the robot.
+    a question; anything else was not said to the robot. ``show(label, words)`` reports each.
     """
-    for block in blocks:
-        for heard in listener.feed(block):
-            _relay(heard, lines, awaiting_answer, show)
-    for heard in listener.close():
-        _relay(heard, lines, awaiting_answer, show)
+    for heard in heard_in(listener, blocks):
+        transcript = heard.transcript
+        if heard.kind == "stop":
+            show("heard", heard.text)
+            lines.put("stop")
+        elif transcript.woken or awaiting_answer():
+            show("heard", heard.text)
+            lines.put(transcript.command)
+        else:
+            show(f"heard (no '{WAKE_WORD}', not for me)", heard.text)
     lines.put(None)
-
-
-def _relay(
-    heard: Heard, lines: queue.Queue[str | None], awaiting_answer: Callable[[], bool], show: Callable[[str], None]
-) -> None:
-    transcript = heard.transcript
-    if heard.kind == "stop":
-        show(f"heard: {heard.text}")
-        lines.put("stop")
-    elif transcript.woken or awaiting_answer():
-        show(f"heard: {heard.text}")
-        lines.put(transcript.command)
-    else:
-        show(f"heard (no '{WAKE_WORD}', not for me): {heard.text}")

@@ -11,7 +11,7 @@ import pytest
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, run_main
 from bt_humanoid.language.asr import CommandRecognizer, command_grammar
 from bt_humanoid.language.audio import espeak_available, read_wav, spoken, synthesize, with_noise, write_wav
-from bt_humanoid.language.listening import END_SILENCE, Listener
+from bt_humanoid.language.listening import END_SILENCE, Listener, heard_in
 from bt_humanoid.language.whisper_asr import WhisperRecognizer, world_prompt
 from bt_humanoid.paths import project_root
 from bt_humanoid.sim.world_config import load_world_config
@@ -86,10 +86,7 @@ def _stream(*parts: tuple[str, float], rng: np.random.Generator, snr_db: float =
 
 
 def _listen(listener: Listener, audio: np.ndarray) -> list:
-    heard = []
-    for start in range(0, len(audio), 1600):  # 100 ms microphone blocks
-        heard.extend(listener.feed(audio[start : start + 1600]))
-    return heard + listener.close()
+    return list(heard_in(listener, (audio[start : start + 1600] for start in range(0, len(audio), 1600))))  # 100 ms
 
 
 def test_the_listener_splits_a_stream_into_utterances(recognizer):

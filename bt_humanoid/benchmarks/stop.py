@@ -1,4 +1,4 @@
-"""Stop benchmark: how fast a typed "stop" brings every motion to rest, in mid-motion.
+"""Stop benchmark: how fast a typed or spoken "stop" brings every motion to rest, in mid-motion.
 
     python -m bt_humanoid.benchmarks.stop --trials 25
 
@@ -9,7 +9,7 @@ way the terminal does: it is planned (the planner answers "stop") and the
 run's stop request is raised. Latency is simulation time from that moment to
 every joint and base speed below 1 cm/s (or rad/s), measured at every
 control step. Prints the median, p95 and worst latency and the speed when
-the stop came. Pinned to one CPU core; ``--json PATH`` also writes the
+the stop came (for a spoken one: when the person began to say it). Pinned to one CPU core; ``--json PATH`` also writes the
 figures.
 """
 

@@ -24,6 +24,7 @@ returns what was heard in it; ``Listener.close`` ends the stream.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
@@ -66,14 +67,12 @@ class Heard:
 class Listener:
     """Segments a 16 kHz stream into utterances, decodes them as they come and spots stops early."""
 
-    def __init__(
-        self, recognizer: CommandRecognizer, vad_mode: int | None = None, transcriber: Transcriber | None = None
-    ) -> None:
+    def __init__(self, recognizer: CommandRecognizer, transcriber: Transcriber | None = None) -> None:
         from pocketsphinx import Vad
 
         self.recognizer = recognizer  # decodes as the person speaks, for stops
         self.transcriber = transcriber or recognizer  # the whole utterance when it ends (Whisper, when given)
-        self.vad = Vad(Vad.LOOSE if vad_mode is None else vad_mode, RATE, FRAME)
+        self.vad = Vad(Vad.LOOSE, RATE, FRAME)
         self.frame_samples = self.vad.frame_bytes // 2
         self._pending = np.zeros(0, dtype=np.int16)
         self._before: deque[np.ndarray] = deque(maxlen=round(PRE_ROLL / FRAME))
@@ -92,10 +91,6 @@ class Listener:
     def seconds(self) -> float:
         """How much of the stream has been listened to."""
         return self._frames * self.frame_samples / RATE
-
-    @property
-    def in_utterance(self) -> bool:
-        return self._in_utterance
 
     def feed(self, samples: np.ndarray) -> list[Heard]:
         """Listen to the next samples of the stream; what was heard in them, in order."""
@@ -121,7 +116,6 @@ class Listener:
             if self._speech_run < START_FRAMES:
                 return []
             self._begin()
-            self._sound = [np.concatenate(list(self._before))]
             return self._listen(self._sound[0])
         self._utterance_frames += 1
         if not speech:  # held back: a pause may be the end, and decoding a long tail of noise loses the command
@@ -138,6 +132,7 @@ class Listener:
 
     def _begin(self) -> None:
         self.recognizer.begin()
+        self._sound = [np.concatenate(list(self._before))]
         self._in_utterance = True
         self._utterance_frames = len(self._before)
         self._speech_frames = START_FRAMES
@@ -160,13 +155,23 @@ class Listener:
 
     def _finish(self) -> list[Heard]:
         self.recognizer.end()  # the running decode was for spotting stops; the whole utterance is decoded again
-        transcript = self.transcriber.transcribe(np.concatenate(self._sound + self._held[: round(TAIL / FRAME)]))
+        sound = np.concatenate(self._sound + self._held[: round(TAIL / FRAME)])
         self._in_utterance = False
         self._speech_run = 0
         self._before.clear()
         self._held.clear()
-        if not transcript.text or self._speech_frames * FRAME < SHORTEST:
+        if self._speech_frames * FRAME < SHORTEST:
+            return []  # a click or a breath: not worth decoding
+        transcript = self.transcriber.transcribe(sound)
+        if not transcript.text:
             return []  # nothing the grammar fits (a cough, a door)
         if is_stop(transcript.text):
             return [] if self._stopped else [Heard("stop", transcript, self.seconds)]
         return [Heard("utterance", transcript, self.seconds)]  # after an early stop too: it was not one after all
+
+
+def heard_in(listener: Listener, blocks: Iterable[np.ndarray]) -> Iterator[Heard]:
+    """Everything ``listener`` hears in a stream of blocks, as it is heard; an utterance open at the end ends there."""
+    for block in blocks:
+        yield from listener.feed(block)
+    yield from listener.close()

@@ -19,15 +19,19 @@ from bt_humanoid.language.audio import RATE, read_wav
 BLOCK = 0.1  # s of sound per block
 
 
-def file_blocks(path: Path, realtime: bool = True) -> Iterator[np.ndarray]:
-    """The sound of a WAV file in blocks, each given when it would have been heard (or at once)."""
+def wav_samples(path: Path, hint: str) -> np.ndarray:
+    """A WAV file's samples at ``RATE``; a UserError (with ``hint``) when it is missing or not a PCM WAV."""
     if not path.is_file():
-        raise UserError(f"{path}: no such file", hint="give a WAV file to listen to, or no file for the microphone")
+        raise UserError(f"{path}: no such file", hint=hint)
     try:
-        samples = read_wav(path)
+        return read_wav(path)
     except ValueError as error:
         raise UserError(str(error)) from None
-    return _paced(samples, realtime)
+
+
+def file_blocks(path: Path, realtime: bool = True) -> Iterator[np.ndarray]:
+    """The sound of a WAV file in blocks, each given when it would have been heard (or at once)."""
+    return _paced(wav_samples(path, "give a WAV file to listen to, or no file for the microphone"), realtime)
 
 
 def _paced(samples: np.ndarray, realtime: bool) -> Iterator[np.ndarray]:

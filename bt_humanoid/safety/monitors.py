@@ -77,20 +77,21 @@ class BumperMonitor:
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, trunk: set[int]) -> None:
         self.model, self.data = model, data
-        self.trunk = trunk  # body ids
-        self.floor = {g for g in range(model.ngeom) if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE}
+        self.on_trunk = np.isin(model.geom_bodyid, sorted(trunk))  # per geom
+        self.floor = model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE  # per geom
 
     def check(self, now: float) -> str | None:
-        model = self.model
-        for contact in self.data.contact[: self.data.ncon]:
-            g1, g2 = int(contact.geom1), int(contact.geom2)
-            for mine, other in ((g1, g2), (g2, g1)):
-                touched = model.geom_bodyid[other] not in self.trunk and other not in self.floor
-                if model.geom_bodyid[mine] in self.trunk and touched:
-                    x, y = contact.pos[:2]
-                    part = model.geom(mine).name or model.body(model.geom_bodyid[mine]).name
-                    return f"the robot's {part} touched something at ({x:.2f}, {y:.2f})"
-        return None
+        contacts = self.data.contact
+        pairs = np.stack([contacts.geom1, contacts.geom2], axis=1)  # (contacts, 2)
+        mine = self.on_trunk[pairs]
+        hit = mine & ~mine[:, ::-1] & ~self.floor[pairs[:, ::-1]]  # trunk side, the other not trunk nor floor
+        rows, sides = np.nonzero(hit)
+        if rows.size == 0:
+            return None
+        geom = int(pairs[rows[0], sides[0]])
+        x, y = contacts.pos[rows[0], :2]
+        part = self.model.geom(geom).name or self.model.body(self.model.geom_bodyid[geom]).name
+        return f"the robot's {part} touched something at ({x:.2f}, {y:.2f})"
 
 
 def trunk_bodies(model: mujoco.MjModel, root: int, hand_bodies: list[int]) -> set[int]:

@@ -65,6 +65,13 @@ class WorldConfig(StrictModel):
     def model_path(self) -> Path:
         return self.folder / self.model
 
+    def outside_map(self, x: float, y: float) -> str | None:
+        """Why (x, y) is not a place on this world's map, or None when it is."""
+        (x0, y0), (x1, y1) = self.bounds
+        if x0 <= x <= x1 and y0 <= y <= y1:
+            return None
+        return f"({x}, {y}) is outside the map: x {x0:g} to {x1:g}, y {y0:g} to {y1:g}"
+
     @property
     def person_names(self) -> list[str]:
         """Every name a person answers to: their own and their aliases ("me", "user")."""

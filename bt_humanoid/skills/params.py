@@ -49,9 +49,5 @@ def check_object(value: str | None, world: WorldConfig, parameter: str = "object
 
 def check_in_map(at: tuple[float, float] | None, world: WorldConfig, parameter: str = "at") -> list[tuple[str, str]]:
     """Compile-time check that a spot ``[x, y]`` (if given) lies inside the world's map."""
-    if at is None:
-        return []
-    (x0, y0), (x1, y1) = world.bounds
-    if x0 <= at[0] <= x1 and y0 <= at[1] <= y1:
-        return []
-    return [(parameter, f"[{at[0]:g}, {at[1]:g}] is outside the map (x {x0:g} to {x1:g}, y {y0:g} to {y1:g})")]
+    problem = world.outside_map(*at) if at is not None else None
+    return [(parameter, problem)] if problem else []
