@@ -9,8 +9,8 @@ way the terminal does: it is planned (the planner answers "stop") and the
 run's stop request is raised. Latency is simulation time from that moment to
 every joint and base speed below 1 cm/s (or rad/s), measured at every
 control step. Prints the median, p95 and worst latency and the speed when
-the stop came (for a spoken one: when the person began to say it). Pinned to one CPU core; ``--json PATH`` also writes the
-figures.
+the stop came (for a spoken one: when the person began to say it). Pinned
+to one CPU core; ``--json PATH`` also writes the figures.
 """
 
 from __future__ import annotations
