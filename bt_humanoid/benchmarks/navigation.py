@@ -53,14 +53,16 @@ class Outcome:
 def random_starts(count: int, rng: np.random.Generator, world: str = "apartment") -> list[tuple[float, float, float]]:
     """Free poses (x, y, yaw_deg) spread over the apartment (away from any walker's loop)."""
     probe = build_run({"mission": "probe", "world": world, "tree": {"wait": {"seconds": 0}}})
-    grid = probe.navigator.grid
-    (x0, y0), (x1, y1) = probe.context.world.bounds
-    starts = []
-    while len(starts) < count:
+    return [free_start(probe.navigator.grid, probe.context.world, rng) for _ in range(count)]
+
+
+def free_start(grid, world, rng: np.random.Generator, clearance: float = START_CLEARANCE) -> tuple[float, float, float]:
+    """One random pose (x, y, yaw_deg) with ``clearance`` of free floor on the map, away from walkers' loops."""
+    (x0, y0), (x1, y1) = world.bounds
+    while True:
         xy = np.array([rng.uniform(x0, x1), rng.uniform(y0, y1)])
-        if grid.clearance_at(xy[None, :])[0] >= START_CLEARANCE and _clear_of_walkers(xy, probe.context.world):
-            starts.append((round(float(xy[0]), 3), round(float(xy[1]), 3), round(float(rng.uniform(-180, 180)), 1)))
-    return starts
+        if grid.clearance_at(xy[None, :])[0] >= clearance and _clear_of_walkers(xy, world):
+            return (round(float(xy[0]), 3), round(float(xy[1]), 3), round(float(rng.uniform(-180, 180)), 1))
 
 
 def _clear_of_walkers(xy: np.ndarray, world) -> bool:

@@ -270,7 +270,7 @@ class MissionLoader:
             elif kind == "at":
                 target = data["at"] if isinstance(data["at"], str) else data["at"]["place"]
                 names = [(target, places)]
-            elif kind in ("in_hand", "upright"):
+            elif kind in ("in_hand", "upright", "delivered"):
                 names = [(data[kind], objects)]
             elif kind == "near":
                 names = [(data["near"]["object"], objects)]

@@ -69,12 +69,24 @@ class NearCondition(StrictModel):
     near: NearSpot = Field(description="the object's centre lies within `within` of a spot (horizontally)")
 
 
+class DeliveredCondition(StrictModel):
+    delivered: str = Field(description="the object was handed over: out of the robot's hands, within 1 m of a person")
+
+
 class GripperCondition(StrictModel):
     gripper: tuple[Literal["left", "right"], Literal["open", "closed"]] = Field(description="[side, state]")
 
 
-SuccessCondition = OnCondition | AtCondition | InHandCondition | UprightCondition | NearCondition | GripperCondition
-CONDITION_KINDS = ("on", "at", "in_hand", "upright", "near", "gripper")
+SuccessCondition = (
+    OnCondition
+    | AtCondition
+    | InHandCondition
+    | UprightCondition
+    | NearCondition
+    | GripperCondition
+    | DeliveredCondition
+)
+CONDITION_KINDS = ("on", "at", "in_hand", "upright", "near", "gripper", "delivered")
 
 
 class MissionHeader(StrictModel):

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from bt_humanoid.control.base_driver import wrap_angle
 from bt_humanoid.mission.schema import (
     AtCondition,
+    DeliveredCondition,
     GripperCondition,
     InHandCondition,
     NearCondition,
@@ -16,6 +17,8 @@ from bt_humanoid.mission.schema import (
     UprightCondition,
 )
 from bt_humanoid.sim.ground_truth import GroundTruth
+
+HANDOVER_REACH = 1.0  # m (horizontal) from a person within which a let-go object counts as handed over
 
 
 @dataclass(frozen=True)
@@ -63,4 +66,12 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
         open_width = 2 * truth.sim.robot.grippers[side].open
         holds = width > 0.9 * open_width if state == "open" else width < 0.5 * open_width
         return ConditionResult(f"{side} gripper {state}", holds, f"jaws {width * 100:.1f} cm apart")
+    if isinstance(condition, DeliveredCondition):
+        obj = condition.delivered
+        x, y, _ = truth.object_position(obj)
+        distance, person = min((math.dist((x, y), truth.person_position(p)[:2]), p) for p in truth.sim.world.people)
+        held = truth.in_hand(obj)
+        holds = held is None and distance <= HANDOVER_REACH
+        detail = f"in the {held} hand" if held else f"{distance:.2f} m from the {person}"
+        return ConditionResult(f"{obj} handed over", holds, detail)
     raise AssertionError(f"unhandled condition {condition!r}")

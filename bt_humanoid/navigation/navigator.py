@@ -53,10 +53,8 @@ class Navigator:
         config = robot.config
         footprint = config.base.footprint_radius
         self.clearance = Clearance(footprint + END_MARGIN, footprint + CLEARANCE_MARGIN)
-        self.grid: OccupancyGrid = static_map(sim.model, sim.data, bounds, RESOLUTION)
-        self.grid.observed_padding = OBSERVED_PADDING
-        # a hit on a face of the furniture may fall in the cell just outside it: that is the furniture too
-        self._near_static = cv2.dilate(self.grid.static.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        self.sim, self.bounds = sim, bounds
+        self.remap()
         camera = next(iter(config.cameras), None)
         self.camera = DepthCamera(sim.model, sim.data, camera, "base") if camera else None
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
@@ -72,6 +70,13 @@ class Navigator:
         self.route: Route | None = None
         self.motion: MotionHandle | None = None  # the follower's handle for the current route
         self.waiting_since: float | None = None  # stopped because no route is free now
+
+    def remap(self) -> None:
+        """Build the floor plan from the furniture where it stands now (at start, or after it was rearranged)."""
+        self.grid: OccupancyGrid = static_map(self.sim.model, self.sim.data, self.bounds, RESOLUTION)
+        self.grid.observed_padding = OBSERVED_PADDING
+        # a hit on a face of the furniture may fall in the cell just outside it: that is the furniture too
+        self._near_static = cv2.dilate(self.grid.static.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
 
     # ------------------------------------------------------------------ goals
 
@@ -221,6 +226,8 @@ class Navigator:
         if self.camera is None:
             return
         scan = self.camera.scan()
+        if scan is None:
+            return  # no frame: the map keeps what it had
         base = self.robot.base.pose()[:2]
         hits = scan.hits
         mine = np.hypot(*(hits[:, :2] - base).T) < self.robot.config.base.footprint_radius + OWN_MARGIN

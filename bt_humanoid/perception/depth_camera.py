@@ -65,9 +65,12 @@ class DepthCamera:
         )
         self._geom_ids = np.zeros(len(self._rays), dtype=np.int32)
         self._distances = np.zeros(len(self._rays))
+        self.dropped_until = -math.inf  # s of simulation time: the camera delivers no frames before then
 
-    def scan(self) -> DepthScan:
-        """Cast every ray from the camera's current pose."""
+    def scan(self) -> DepthScan | None:
+        """Cast every ray from the camera's current pose; None while the camera is dropped out."""
+        if self.data.time < self.dropped_until:
+            return None
         origin = self.data.cam_xpos[self.camera].copy()
         rotation = self.data.cam_xmat[self.camera].reshape(3, 3)
         directions = self._rays @ rotation.T

@@ -44,6 +44,31 @@ def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame)
             tracked.confidence *= LOSS
             if tracked.confidence < GONE:
                 tracked.confidence = 0.0
+    _reidentify(belief)
+
+
+def _reidentify(belief: WorldModel) -> None:
+    """An object that is gone from where it was, and one like it that turned up since, are the same object.
+
+    Someone moved it, or it fell: the old identity (which plans and the blackboard refer to) takes the new
+    sighting, when exactly one gone object and exactly one newcomer of that kind and colour pair up.
+    """
+    objects = belief.objects
+
+    def alike(a: TrackedObject, b: TrackedObject) -> bool:
+        return a.kind == b.kind and a.colour == b.colour
+
+    gone = [o for o in objects.values() if o.confidence <= 0.0 and o.held_by is None]
+    for old in gone:
+        newcomers = [o for o in objects.values() if o.confidence > 0.0 and alike(o, old) and o.first_seen > old.last_seen]
+        if len(newcomers) != 1:
+            continue
+        new = newcomers[0]
+        if sum(1 for o in gone if alike(o, new) and new.first_seen > o.last_seen) != 1:
+            continue
+        for name in ("position", "yaw", "yaw_known", "size", "confidence", "last_seen", "first_seen", "votes"):
+            setattr(old, name, getattr(new, name))
+        del objects[new.id]
 
 
 def _nearest(belief: WorldModel, detection: Detection) -> TrackedObject | None:
@@ -68,6 +93,7 @@ def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject
         size=detection.size.copy(),
         confidence=GAIN,
         last_seen=time,
+        first_seen=time,
         keep_upright=detection.kind in ("bottle", "mug", "can"),
     )
     tracked.votes[(detection.kind, detection.colour)] += 1

@@ -10,6 +10,7 @@ robot filters itself out of its point cloud.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 
 import mujoco
@@ -42,6 +43,7 @@ class Perceiver:
         self._segmentation = mujoco.Renderer(sim.model, config.height, config.width)
         self._segmentation.enable_segmentation_rendering()
         self.frames = 0
+        self.look_times: list[float] = []  # wall seconds per look (capture, detection, fusion), for benchmarks
 
     def step(self) -> None:
         if self.sim.time - self.last_look >= self.period - 1e-9:
@@ -59,12 +61,16 @@ class Perceiver:
     def look(self) -> list[Detection]:
         """Capture a frame now, detect objects in it and fuse them into the WorldModel."""
         self.last_look = self.sim.time
+        started = time.perf_counter()
         frame = self.camera.capture()
+        if frame is None:
+            return []  # no frame: the belief keeps what it had
         self._mask_robot(frame)
         belief = self.world_model()
         detections = detect(frame, list(belief.surfaces.values()))
         integrate(belief, detections, frame)
         self.frames += 1
+        self.look_times.append(time.perf_counter() - started)
         return detections
 
     def _mask_robot(self, frame: RgbdFrame) -> None:

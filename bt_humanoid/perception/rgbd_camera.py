@@ -56,8 +56,12 @@ class RgbdCamera:
         self._depth.enable_depth_rendering()
         fovy = math.radians(float(sim.model.cam_fovy[self.camera]))
         self.focal = (height / 2) / math.tan(fovy / 2)
+        self.dropped_until = -math.inf  # s of simulation time: the camera delivers no frames before then
 
-    def capture(self) -> RgbdFrame:
+    def capture(self) -> RgbdFrame | None:
+        """A frame, or None while the camera is dropped out (a covered lens, a driver restart)."""
+        if self.sim.time < self.dropped_until:
+            return None
         data = self.sim.data
         rgb = self._render(self._colour)
         depth = self._render(self._depth).astype(np.float64)

@@ -30,6 +30,7 @@ class TrackedObject:
     size: np.ndarray  # full extents (x, y, z) in the object's frame (m)
     confidence: float = 1.0
     last_seen: float = 0.0  # s of simulation time
+    first_seen: float = 0.0  # s of simulation time it was first seen (where it is now)
     keep_upright: bool = False
     held_by: str | None = None  # gripper side while the robot holds it
     grip_offset: float = 0.0  # m the grip site sits above the centre, while held

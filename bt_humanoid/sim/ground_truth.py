@@ -48,6 +48,12 @@ class GroundTruth:
         mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, body, velocity, 0)
         return float(np.linalg.norm(velocity[3:]))
 
+    def person_position(self, name: str) -> np.ndarray:
+        """Where a person of world.yaml (or a walker) is now."""
+        people = self.sim.world.people
+        body = people[name].body if name in people else name
+        return self.data.xpos[self.model.body(body).id].copy()
+
     def robot_pose(self) -> tuple[float, float, float]:
         """(x, y, yaw in radians) of the base."""
         joints = self.sim.robot.base.joints
@@ -99,6 +105,11 @@ class GroundTruth:
     def gripper_width(self, side: str) -> float:
         joints = self.sim.robot.grippers[side].joints
         return float(sum(self.data.qpos[self.model.joint(j).qposadr[0]] for j in joints))
+
+    def people_bodies(self) -> set[int]:
+        """Bodies of the world's people and walkers."""
+        names = [p.body for p in self.sim.world.people.values()] + list(self.sim.world.walkers)
+        return {self.model.body(name).id for name in names}
 
     def robot_contacts(self) -> list[tuple[str, str]]:
         """Contacts between the robot and anything else, as (robot geom, other geom) names."""

@@ -1,0 +1,1 @@
+"""bt-eval: benchmark suites over randomized scenes, with injected faults."""

@@ -1,0 +1,135 @@
+"""bt-eval SUITE: run a benchmark suite's episodes in parallel, print the figures and save them as JSON."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+from rich.table import Table
+
+from bt_humanoid.cli import EXIT_OK, _fail_invalid, _Parser
+from bt_humanoid.errors import UserError
+from bt_humanoid.evaluation.report import summarize
+from bt_humanoid.evaluation.suite import load_suite
+from bt_humanoid.paths import missions_dir
+
+
+def _parser() -> _Parser:
+    parser = _Parser(prog="bt-eval", description="Run a benchmark suite over randomized scenes and report.")
+    parser.add_argument("suite", help="a suite YAML file, or the name of one in missions/benchmarks/ (e.g. fetch)")
+    parser.add_argument("--episodes", type=int, help="how many episodes (default: the suite's)")
+    parser.add_argument("--seed", type=int, help="draws every scene (default: the suite's)")
+    parser.add_argument("--workers", type=int, default=1, help="worker processes, one core each (default 1)")
+    parser.add_argument("--backend", choices=["local", "ray"], default="local", help="where episodes run")
+    parser.add_argument("--address", help="Ray cluster address for --backend ray (default: start a local Ray)")
+    parser.add_argument("--json", type=Path, help="write figures and episodes here (default: bt-eval-SUITE.json)")
+    return parser
+
+
+def _suite_file(name: str) -> Path:
+    path = Path(name)
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        return path
+    return missions_dir() / "benchmarks" / f"{name}.yaml"
+
+
+def eval_main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    console = Console(highlight=False, soft_wrap=True)
+    try:
+        if args.workers < 1:
+            raise UserError(f"--workers {args.workers}: give 1 or more")
+        if args.episodes is not None and args.episodes < 1:
+            raise UserError(f"--episodes {args.episodes}: give 1 or more")
+        if args.seed is not None and args.seed < 0:
+            raise UserError(f"--seed {args.seed}: give 0 or more")
+        file = _suite_file(args.suite)
+        suite, _ = load_suite(file)
+        episodes = args.episodes or suite.episodes
+        seed = suite.seed if args.seed is None else args.seed
+        console.print(
+            f"bt-eval [bold]{suite.suite}[/]: {episodes} episodes, seed {seed}, "
+            f"{args.workers if args.backend == 'local' else 'ray'} worker(s) — {suite.description}"
+        )
+        records, wall = _run(str(file.resolve()), list(range(episodes)), seed, args, console)
+    except UserError as error:
+        return _fail_invalid(error)
+    records.sort(key=lambda r: r["episode"])
+    figures = summarize(records, wall, args.workers)
+    figures = {"suite": suite.suite, "file": str(file), "seed": seed, **figures}
+    _print(console, figures)
+    out = args.json or Path(f"bt-eval-{suite.suite}.json")
+    out.write_text(json.dumps({**figures, "episodes": records}, indent=1) + "\n")
+    console.print(f"wrote {out}")
+    return EXIT_OK
+
+
+def _run(file: str, indices: list[int], seed: int, args, console: Console) -> tuple[list[dict[str, Any]], float]:
+    from bt_humanoid.evaluation.backends import run_local, run_ray
+
+    stream = (
+        run_ray(file, indices, seed, args.address)
+        if args.backend == "ray"
+        else run_local(file, indices, seed, args.workers)
+    )
+    records: list[dict[str, Any]] = []
+    started = time.perf_counter()
+    columns = (
+        TextColumn("[progress.description]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[rate]}"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, console=console, transient=False) as progress:
+        bar = progress.add_task("episodes", total=len(indices), rate="")
+        for record in stream:
+            records.append(record)
+            wins = sum(r["success"] for r in records)
+            progress.update(bar, advance=1, rate=f"{wins}/{len(records)} succeeded")
+            if not record["success"]:
+                progress.console.print(
+                    f"  episode {record['episode']} ({record['command'] or record['task']}"
+                    f"{', fault ' + record['fault'] if record['fault'] else ''}): {record['failure']}"
+                )
+    return records, time.perf_counter() - started
+
+
+def _percent(rate: dict[str, Any]) -> str:
+    low, high = rate["ci95"]
+    return f"{rate['rate']:.1%}  [{low:.1%}, {high:.1%}]  ({rate['successes']}/{rate['episodes']})"
+
+
+def _print(console: Console, figures: dict[str, Any]) -> None:
+    table = Table(title=f"{figures['suite']}: success with 95 % confidence interval", title_justify="left")
+    table.add_column("group")
+    table.add_column("success")
+    table.add_row("all", _percent(figures["success"]))
+    for key in ("by_task", "by_object", "by_fault"):
+        for name, rate in figures[key].items():
+            table.add_row(f"{key[3:]}: {name}", _percent(rate))
+    console.print(table)
+
+    def ms(value: float | None, unit: str = "ms", digits: int = 1) -> str:
+        return f"{value:.{digits}f} {unit}" if value is not None else "-"
+
+    done, latency = figures["time_to_complete_s"], figures["stop_latency_s"]
+    lines = [
+        f"time to complete (successes): median {ms(done['median'], 's')}, p95 {ms(done['p95'], 's')}",
+        f"episodes with a person touched: {figures['episodes_with_person_contact']}; "
+        f"stopped by the bumper: {figures['episodes_with_collision_stop']}; "
+        f"ended still moving: {figures['episodes_ended_moving']}",
+        f"stop latency (new command → rest): median {ms(latency['median'], 's', 2)}, "
+        f"p95 {ms(latency['p95'], 's', 2)} over {latency['count']}",
+        f"plan {ms(figures['plan_ms_median'])}, camera look {ms(figures['look_ms_median'])}, "
+        f"whole-body QP {ms(figures['qp_ms_median'], 'ms', 3)} (medians)",
+        f"real-time factor per core {figures['real_time_factor_per_core']:.1f}×; "
+        f"wall {figures['wall_s']:.0f} s with {figures['workers']} worker(s)",
+    ]
+    for line in lines:
+        console.print("  " + line)

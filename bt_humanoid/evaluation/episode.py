@@ -1,0 +1,259 @@
+"""One evaluation episode: draw the scene, plan the command, inject the fault, run, judge in ground truth.
+
+``run_episode(suite_file, index)`` is all a worker process needs: the suite
+is loaded again in the worker, and everything the episode draws comes from
+``(suite seed, index)``, so episodes do not depend on which worker runs them
+or in what order. The result is a plain dict (JSON, and picklable for
+process pools and Ray).
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import time
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from bt_humanoid.benchmarks.navigation import free_start
+from bt_humanoid.commanding import plan_command
+from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.evaluation import faults as fault_kinds
+from bt_humanoid.evaluation.scenes import nudge, reachable_spot
+from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite
+from bt_humanoid.language.plan import PlanningContext
+from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
+from bt_humanoid.mission.success import check_condition
+from bt_humanoid.testing.scenario import build_run
+from bt_humanoid.testing.scene import place_object
+
+AT_REST = 0.01  # m/s or rad/s: faster than this at the end counts as still moving
+
+
+@cache
+def _suite(path: str) -> Suite:
+    return load_suite(Path(path))[0]
+
+
+@cache
+def _probe(world: str, robot: str) -> MissionRun:
+    """A run of the bare world: its map and surfaces, for drawing scenes (one per worker)."""
+    run = build_run({"mission": "probe", "world": world, "robot": robot, "tree": {"wait": {"seconds": 0}}})
+    if run.perceiver is not None:
+        run.perceiver.close()
+    return run
+
+
+class Draw:
+    """What one episode drew: task, names, start, spots, fault."""
+
+    def __init__(self, suite: Suite, index: int) -> None:
+        rng = np.random.default_rng([suite.seed, index])
+        self.rng = rng
+        weights = np.array([task.weight for task in suite.tasks])
+        self.task_index = int(rng.choice(len(suite.tasks), p=weights / weights.sum()))
+        self.obj = str(rng.choice(suite.objects)) if suite.objects else ""
+        self.start_surface = str(rng.choice(suite.randomize.object_on)) if suite.randomize.object_on else None
+        others = [s for s in suite.surfaces if s != self.start_surface] or suite.surfaces
+        self.surface = str(rng.choice(others)) if others else ""
+        faulted = suite.faults.kinds and rng.uniform() < suite.faults.share
+        self.fault_index = int(rng.integers(len(suite.faults.kinds))) if faulted else None
+        self.side_sign = float(rng.choice([-1.0, 1.0]))
+        self.spare_spots: list[np.ndarray] = []  # filled at set-up: where a moved object may go
+
+    @property
+    def slots(self) -> dict[str, str]:
+        return {"object": self.obj, "surface": self.surface}
+
+
+def run_episode(suite_file: str, index: int, seed: int | None = None) -> dict[str, Any]:
+    """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``); figures and verdict as a dict."""
+    started = time.perf_counter()
+    suite = _suite(suite_file)
+    if seed is not None:
+        suite = suite.model_copy(update={"seed": seed})
+    draw = Draw(suite, index)
+    task = suite.tasks[draw.task_index]
+    fault = suite.faults.kinds[draw.fault_index] if draw.fault_index is not None else None
+    record: dict[str, Any] = {
+        "episode": index,
+        "task": task.command or task.mission,
+        "command": fill(task.command, draw.slots) if task.command else None,
+        "object": draw.obj or None,
+        "surface": draw.surface or None,
+        "fault": fault.kind if fault else None,
+    }
+    run = _set_up(suite, draw, record)
+    try:
+        record |= _play(suite, suite_file, task, draw, fault, run)
+    finally:
+        if run.perceiver is not None:
+            run.perceiver.close()
+    record["wall_s"] = round(time.perf_counter() - started, 3)
+    return record
+
+
+def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> MissionRun:
+    """The episode's run, its scene drawn: obstacles nudged, the object on a random spot, a random start."""
+    probe = _probe(suite.world, suite.robot)
+    rng, world = draw.rng, probe.context.world
+    start = free_start(probe.navigator.grid, world, rng) if suite.randomize.start == "random" else None
+    idle = {"mission": "ready", "world": suite.world, "robot": suite.robot, "tree": {"wait": {"seconds": 0}}}
+    run = build_run(idle, robot_start=start)
+    model = run.sim.model
+    for name in suite.randomize.obstacles:  # the furniture rearranged, and the robot's floor plan redrawn
+        body = model.body(name).id
+        model.body_pos[body] = nudge(model.body_pos[body], suite.randomize.obstacle_shift, rng)
+    if suite.randomize.obstacles:
+        mujoco.mj_forward(model, run.sim.data)
+        run.navigator.remap()
+    record["start"] = list(start) if start else None
+    if draw.start_surface is not None and draw.obj:
+        surface = run.context.world_model.surface(draw.start_surface)
+        others = [run.truth.object_position(o) for o in world.objects if o != draw.obj]
+        footprint = run.context.robot_config.base.footprint_radius
+        spot = reachable_spot(surface, probe.navigator.grid, footprint, np.array(world.bounds), others, rng)
+        place_object(run, draw.obj, float(spot[0]), float(spot[1]), float(rng.uniform(-math.pi, math.pi)))
+        record["object_at"] = [draw.start_surface, round(float(spot[0]), 3), round(float(spot[1]), 3)]
+    draw.spare_spots = _spare_spots(run, draw, probe)
+    return run
+
+
+def _spare_spots(run: MissionRun, draw: Draw, probe: MissionRun) -> list[np.ndarray]:
+    """Free reachable spots on the object's surface, for a fault that moves it."""
+    if draw.start_surface is None or not draw.obj:
+        return []
+    surface = run.context.world_model.surface(draw.start_surface)
+    footprint = run.context.robot_config.base.footprint_radius
+    others = [run.truth.object_position(o) for o in run.context.world.objects]
+    bounds = np.array(run.context.world.bounds)
+    spots = []
+    for _ in range(5):
+        try:
+            spots.append(reachable_spot(surface, probe.navigator.grid, footprint, bounds, others + spots, draw.rng))
+        except ValueError:
+            break
+    return spots
+
+
+def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, run: MissionRun) -> dict[str, Any]:
+    """Plan (for commands), run with the fault armed, follow a new command if one arrives, and judge."""
+    figures: dict[str, Any] = {"plan_ms": [], "stop_latency_s": None}
+    if run.perceiver is not None:
+        run.perceiver.look()
+    expect = fill(task.expect, draw.slots)
+    spec = _mission(suite, suite_file, task, draw, run, figures)
+    if isinstance(spec, str):
+        return _verdict(run, None, expect, figures, failure=spec)
+    run.follow_with(spec)
+    injector = _arm(fault, run, draw) if fault is not None else None
+    people = run.truth.people_bodies()
+    touched: list[float] = []
+
+    def watch_people() -> None:
+        for contact in run.sim.data.contact:
+            b1, b2 = run.sim.model.geom_bodyid[contact.geom1], run.sim.model.geom_bodyid[contact.geom2]
+            robot = run.truth.robot_bodies
+            if (b1 in people and b2 in robot) or (b2 in people and b1 in robot):
+                touched.append(run.sim.time)
+                return
+
+    run.executor.observers.append(watch_people)
+    result = run.execute(keep_open=True)
+    if isinstance(injector, fault_kinds.NewCommand) and injector.fired is not None:
+        rest = next((e["t"] for e in reversed(result.events.events) if e["event"] in ("rest", "moving")), None)
+        figures["stop_latency_s"] = round(rest - injector.fired.time, 3) if rest is not None else None
+        command = fill(injector.settings.command, draw.slots)
+        expect = fill(injector.settings.expect, draw.slots)
+        follow = _planned(command, suite, run, figures)
+        if isinstance(follow, str):
+            return _verdict(run, result, expect, figures, failure=follow, injector=injector, touched=touched)
+        run.follow_with(follow)
+        result = run.execute(keep_open=True)
+    return _verdict(run, result, expect, figures, injector=injector, touched=touched)
+
+
+def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, run: MissionRun, figures: dict):
+    """The episode's validated mission, or why there is none (a string)."""
+    if task.mission is not None:
+        spec = MissionLoader().load_file(Path(suite_file).parent / task.mission)
+        spec.header.safety.time_budget = suite.time_budget
+        return spec
+    return _planned(fill(task.command, draw.slots), suite, run, figures)
+
+
+def _planned(command: str, suite: Suite, run: MissionRun, figures: dict):
+    """Plan a command from what the robot believes now; the validated mission, or the planner's answer."""
+    context = PlanningContext(run.context.world, run.context.world_model, run.robot.base.pose(), suite.robot)
+    started = time.perf_counter()
+    outcome = plan_command(command, context, lambda question: None)
+    figures["plan_ms"].append(round((time.perf_counter() - started) * 1000, 2))
+    if outcome.plan.kind != "mission" or outcome.plan.mission is None:
+        return f"planner: {outcome.plan.say}"
+    mission = {**outcome.plan.mission, "safety": {"time_budget": suite.time_budget}}
+    return MissionLoader().load_data(mission, name="<command>")
+
+
+def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:
+    kind, settings = fault.kind, fault.settings
+    if kind == "slip":
+        return fault_kinds.Slip(run, draw.obj, settings)
+    if kind == "target_moved":
+        return fault_kinds.TargetMoved(run, draw.obj, settings, draw.spare_spots)
+    if kind == "obstacle_dropped":
+        return fault_kinds.ObstacleDropped(run, settings)
+    if kind == "push":
+        return fault_kinds.Push(run, settings, draw.side_sign)
+    if kind == "blind":
+        return fault_kinds.Blind(run, settings)
+    if kind == "new_command":
+        return fault_kinds.NewCommand(run, fill(settings.command, draw.slots), settings)
+    raise AssertionError(f"no injector for {kind}")
+
+
+def _verdict(
+    run: MissionRun,
+    result,
+    expect: list[dict[str, Any]],
+    figures: dict[str, Any],
+    failure: str | None = None,
+    injector: fault_kinds.Injector | None = None,
+    touched: list[float] | None = None,
+) -> dict[str, Any]:
+    """Success in ground truth, and the figures the suite aggregates."""
+    header = MissionHeader.model_validate({"mission": "expect", "success": expect})
+    conditions = list(header.success)
+    world = run.context.world
+    for condition in header.success:  # things people keep upright must arrive upright
+        if isinstance(condition, OnCondition) and world.objects[condition.on[0]].upright:
+            conditions.append(UprightCondition(upright=condition.on[0]))
+    checked = [check_condition(c, run.truth) for c in conditions]
+    unmet = [f"{c.condition} ({c.detail})" for c in checked if not c.holds]
+    if failure is None and result is not None:
+        if result.tree_status != "SUCCESS":
+            failure = f"safety stop: {result.safety}" if result.safety else (result.cause or result.tree_status)
+        elif unmet:
+            failure = "not done: " + "; ".join(unmet)
+    qp = [t * 1000 for t in run.robot.whole_body.solve_times]
+    looks = [t * 1000 for t in run.perceiver.look_times] if run.perceiver is not None else []
+    speed = run.robot.max_speed()
+    return {
+        "success": failure is None and not unmet,
+        "failure": failure,
+        "fault_fired": injector.fired.what if injector is not None and injector.fired else None,
+        "sim_time": round(run.sim.time, 3),
+        "person_contacts": len(touched or []),
+        "collision": bool(result is not None and result.safety and result.safety.startswith("collision")),
+        "ended_moving": speed >= AT_REST,
+        "final_speed": round(speed, 4),
+        "plan_ms": figures["plan_ms"],
+        "stop_latency_s": figures["stop_latency_s"],
+        "look_ms_median": round(statistics.median(looks), 3) if looks else None,
+        "qp_ms_median": round(statistics.median(qp), 4) if qp else None,
+        "qp_ms_p95": round(float(np.percentile(qp, 95)), 4) if qp else None,
+    }

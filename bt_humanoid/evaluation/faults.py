@@ -1,0 +1,305 @@
+"""Fault injection: things that go wrong in a home, declared in YAML, injected into a running episode.
+
+Each kind has a settings model (what a suite or a test writes, e.g.
+``- push: {force: 250}``) and an injector that watches the run after every
+control step and fires once, when its moment comes:
+
+- ``slip``: the object's surface turns slippery just after it is lifted, so it slides out of the fingers;
+- ``target_moved``: someone moves the object to another spot while the robot drives towards it;
+- ``obstacle_dropped``: a box lands on the floor in front of the robot while it drives;
+- ``push``: someone shoves the robot sideways while it drives;
+- ``blind``: the head camera delivers no frames (colour and depth) for some seconds;
+- ``new_command``: a new command arrives mid-mission; the robot stops and does that instead.
+
+Injectors are evaluation code: they read the simulator's ground truth to
+pick their moment and act on the world the way the world would (forces,
+friction, a box arriving, an object put elsewhere). The robot learns of a
+fault only through its sensors.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import mujoco
+import numpy as np
+from pydantic import Field
+
+from bt_humanoid.strict_model import StrictModel
+
+if TYPE_CHECKING:
+    from bt_humanoid.engine.runner import MissionRun
+
+PLACE_CLEARANCE = 1.0  # m a dropped box keeps from goals, named places and people
+DRIVING = 0.15  # m/s of base speed above which the robot counts as driving
+SPARE_BOX = "parcel"  # the free box in a corner of the apartment that obstacle_dropped drops on the robot's way
+
+
+class SlipSettings(StrictModel):
+    friction: float = Field(0.02, gt=0, le=1, description="the object's friction while slippery")
+    seconds: float = Field(1.0, gt=0, le=10, description="how long it stays slippery")
+    lifted: float = Field(0.02, gt=0, le=0.2, description="m above where it rested when the slip starts")
+
+
+class TargetMovedSettings(StrictModel):
+    distance: float = Field(0.2, gt=0, le=1, description="m, the least distance it is moved")
+    within: float = Field(2.5, gt=0, le=10, description="m between robot and object when it is moved")
+
+
+class ObstacleDroppedSettings(StrictModel):
+    ahead: float = Field(1.4, gt=0.6, le=4, description="m ahead of the base where the box lands")
+
+
+class PushSettings(StrictModel):
+    force: float = Field(250.0, gt=0, le=2000, description="N, sideways on the base")
+    seconds: float = Field(0.3, gt=0, le=2, description="how long the shove lasts")
+
+
+class BlindSettings(StrictModel):
+    seconds: float = Field(4.0, gt=0, le=60, description="how long the camera delivers no frames")
+    after: float = Field(1.0, ge=0, le=600, description="s into the mission when it starts")
+
+
+class NewCommandSettings(StrictModel):
+    command: str = Field(description="what the person says; {object} and {surface} are filled per episode")
+    expect: list[dict[str, Any]] = Field(description="success conditions of the new command")
+    after: float = Field(8.0, ge=0, le=600, description="s into the mission when it arrives")
+
+
+FAULT_MODELS: dict[str, type[StrictModel]] = {
+    "slip": SlipSettings,
+    "target_moved": TargetMovedSettings,
+    "obstacle_dropped": ObstacleDroppedSettings,
+    "push": PushSettings,
+    "blind": BlindSettings,
+    "new_command": NewCommandSettings,
+}
+
+
+class FaultConfig(StrictModel):
+    """One fault, written as ``- KIND: {settings}``."""
+
+    slip: SlipSettings | None = None
+    target_moved: TargetMovedSettings | None = None
+    obstacle_dropped: ObstacleDroppedSettings | None = None
+    push: PushSettings | None = None
+    blind: BlindSettings | None = None
+    new_command: NewCommandSettings | None = None
+
+    def model_post_init(self, context: Any) -> None:
+        given = [kind for kind in FAULT_MODELS if getattr(self, kind) is not None]
+        if len(given) != 1:
+            raise ValueError(f"give exactly one fault kind: {', '.join(FAULT_MODELS)}")
+
+    @property
+    def kind(self) -> str:
+        return next(kind for kind in FAULT_MODELS if getattr(self, kind) is not None)
+
+    @property
+    def settings(self) -> StrictModel:
+        return getattr(self, self.kind)
+
+
+@dataclass
+class Fired:
+    time: float
+    what: str
+
+
+class Injector:
+    """Watches a run after every control step; ``fire()``s once when its moment comes."""
+
+    kind = "fault"
+
+    def __init__(self, run: MissionRun) -> None:
+        self.run = run
+        self.fired: Fired | None = None
+        run.executor.observers.append(self.step)
+
+    def step(self) -> None:
+        if self.fired is None:
+            self.watch()
+        else:
+            self.after()
+
+    def watch(self) -> None:
+        """Check for the moment; call ``fire()`` when it comes."""
+
+    def after(self) -> None:
+        """Runs every step once fired (to end a shove, dry a surface)."""
+
+    def fire(self, what: str) -> None:
+        self.fired = Fired(self.run.sim.time, what)
+        self.run.events.add(self.run.sim.time, "fault", kind=self.kind, what=what)
+
+    def driving(self) -> bool:
+        return float(np.hypot(*self.run.robot.base.speeds()[:2])) > DRIVING
+
+
+def _object_geoms(run: MissionRun, name: str) -> list[int]:
+    model = run.sim.model
+    body = model.body(run.context.world.objects[name].body).id
+    return list(range(model.body_geomadr[body], model.body_geomadr[body] + model.body_geomnum[body]))
+
+
+def move_free_body(run: MissionRun, body: str, position: np.ndarray) -> None:
+    """Put a free body elsewhere, turned as it was, at rest: how fault injection makes the world change."""
+    model, data = run.sim.model, run.sim.data
+    joint = model.body_jntadr[model.body(body).id]
+    address, dof = model.jnt_qposadr[joint], model.jnt_dofadr[joint]
+    data.qpos[address : address + 3] = position
+    data.qvel[dof : dof + 6] = 0.0
+    mujoco.mj_forward(model, data)
+
+
+class Slip(Injector):
+    kind = "slip"
+
+    def __init__(self, run: MissionRun, obj: str, settings: SlipSettings) -> None:
+        super().__init__(run)
+        self.obj, self.settings = obj, settings
+        self.geoms = _object_geoms(run, obj)
+        self.friction = run.sim.model.geom_friction[self.geoms].copy()
+        self.rest_height = float(run.truth.object_position(obj)[2])
+        self.dried = False
+
+    def watch(self) -> None:
+        truth = self.run.truth
+        lifted = truth.object_position(self.obj)[2] - self.rest_height
+        if lifted > self.settings.lifted and truth.in_hand(self.obj) is not None:
+            self.run.sim.model.geom_friction[self.geoms, 0] = self.settings.friction
+            self.fire(f"the {self.obj} turned slippery {lifted * 100:.0f} cm above where it rested")
+
+    def after(self) -> None:
+        if not self.dried and self.run.sim.time > self.fired.time + self.settings.seconds:
+            self.run.sim.model.geom_friction[self.geoms] = self.friction
+            self.dried = True
+
+
+class TargetMoved(Injector):
+    kind = "target_moved"
+
+    def __init__(self, run: MissionRun, obj: str, settings: TargetMovedSettings, spots: list[np.ndarray]) -> None:
+        super().__init__(run)
+        self.obj, self.settings = obj, settings
+        self.spots = spots  # reachable free (x, y) spots on surfaces, from the episode's scene sampler
+
+    def watch(self) -> None:
+        truth = self.run.truth
+        position = truth.object_position(self.obj)
+        robot = np.array(truth.robot_pose()[:2])
+        near = np.hypot(*(position[:2] - robot)) < self.settings.within
+        if not (near and self.driving() and truth.in_hand(self.obj) is None):
+            return
+        surface = self.run.context.world_model.surface_under(position + np.array([0, 0, 0.5]))
+        options = [
+            s
+            for s in self.spots
+            if np.hypot(*(s[:2] - position[:2])) >= self.settings.distance
+            and surface is not None
+            and surface.contains(s[:2])
+        ]
+        if not options:
+            return
+        spot = options[0]
+        body = self.run.context.world.objects[self.obj].body
+        move_free_body(self.run, body, np.array([spot[0], spot[1], position[2] + 0.002]))
+        self.fire(f"the {self.obj} was moved {np.hypot(*(spot[:2] - position[:2])):.2f} m")
+
+
+class ObstacleDropped(Injector):
+    kind = "obstacle_dropped"
+
+    def __init__(self, run: MissionRun, settings: ObstacleDroppedSettings) -> None:
+        super().__init__(run)
+        self.settings = settings
+        model = run.sim.model
+        self.box = model.body(SPARE_BOX).id  # KeyError: the world has no spare box
+        geom = model.body_geomadr[self.box]
+        self.half = float(model.geom_size[geom][:2].max())
+
+    def watch(self) -> None:
+        if not self.driving():
+            return
+        vx, vy, _ = self.run.robot.base.speeds()
+        x, y, _ = self.run.truth.robot_pose()
+        heading = np.array([vx, vy]) / max(float(np.hypot(vx, vy)), 1e-9)
+        spot = np.array([x, y]) + self.settings.ahead * heading
+        if not self._fair(spot):
+            return
+        height = self.run.sim.model.geom_size[self.run.sim.model.body_geomadr[self.box]][2]
+        move_free_body(self.run, SPARE_BOX, np.array([*spot, height + 0.01]))
+        self.fire(f"a box landed {self.settings.ahead:.1f} m ahead, at ({spot[0]:.2f}, {spot[1]:.2f})")
+
+    def _fair(self, spot: np.ndarray) -> bool:
+        """Open floor with room to drive round the box, not on the robot's goal, a named place or a person."""
+        run = self.run
+        footprint = run.context.robot_config.base.footprint_radius
+        if run.navigator.grid.clearance_at(spot[None, :])[0] < self.half + 2 * footprint:
+            return False
+        keep_clear = [np.array(p.pose[:2]) for p in run.context.world.places.values()]
+        keep_clear += [run.truth.person_position(name)[:2] for name in run.context.world.people]
+        keep_clear += [run.truth.person_position(name)[:2] for name in run.context.world.walkers]
+        if run.navigator.goal is not None:
+            keep_clear.append(np.asarray(run.navigator.goal[:2]))
+        return all(np.hypot(*(spot - other)) >= PLACE_CLEARANCE for other in keep_clear)
+
+
+class Push(Injector):
+    kind = "push"
+
+    def __init__(self, run: MissionRun, settings: PushSettings, sign: float) -> None:
+        super().__init__(run)
+        self.settings, self.sign = settings, sign
+        self.base = run.sim.model.body("base").id
+        self.released = False
+
+    def watch(self) -> None:
+        if not self.driving():
+            return
+        _, _, yaw = self.run.truth.robot_pose()
+        sideways = self.sign * np.array([-math.sin(yaw), math.cos(yaw), 0.0])
+        self.run.sim.data.xfrc_applied[self.base, :3] = self.settings.force * sideways
+        self.fire(f"pushed {'left' if self.sign > 0 else 'right'} with {self.settings.force:.0f} N")
+
+    def after(self) -> None:
+        if not self.released and self.run.sim.time > self.fired.time + self.settings.seconds:
+            self.run.sim.data.xfrc_applied[self.base, :3] = 0.0
+            self.released = True
+
+
+class Blind(Injector):
+    kind = "blind"
+
+    def __init__(self, run: MissionRun, settings: BlindSettings) -> None:
+        super().__init__(run)
+        self.settings = settings
+        self.start = run.sim.time + settings.after
+
+    def watch(self) -> None:
+        if self.run.sim.time < self.start:
+            return
+        until = self.run.sim.time + self.settings.seconds
+        if self.run.perceiver is not None:
+            self.run.perceiver.camera.dropped_until = until
+        if self.run.navigator.camera is not None:
+            self.run.navigator.camera.dropped_until = until
+        self.fire(f"the head camera gave no frames for {self.settings.seconds:.0f} s")
+
+
+class NewCommand(Injector):
+    """Asks the run to stop when the new command arrives; the episode runner then plans and runs it."""
+
+    kind = "new_command"
+
+    def __init__(self, run: MissionRun, command: str, settings: NewCommandSettings) -> None:
+        super().__init__(run)
+        self.command, self.settings = command, settings
+        self.start = run.sim.time + settings.after
+
+    def watch(self) -> None:
+        if self.run.sim.time >= self.start:
+            self.run.request_stop(f"a new command: {self.command}")
+            self.fire(f'"{self.command}" arrived')

@@ -1,0 +1,78 @@
+"""A suite's figures from its episodes: success with a 95 % confidence interval, times, safety, timings."""
+
+from __future__ import annotations
+
+import math
+import statistics
+from collections import defaultdict
+from typing import Any
+
+Z95 = 1.959964  # two-sided 95 % normal quantile
+
+
+def wilson_interval(successes: int, trials: int, z: float = Z95) -> tuple[float, float]:
+    """The Wilson score interval of a success rate: sound at 0 % and 100 % and for small counts."""
+    if trials == 0:
+        return (0.0, 1.0)
+    p = successes / trials
+    denominator = 1 + z * z / trials
+    centre = (p + z * z / (2 * trials)) / denominator
+    half = z * math.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denominator
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def _rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
+    wins = sum(e["success"] for e in episodes)
+    low, high = wilson_interval(wins, len(episodes))
+    return {"episodes": len(episodes), "successes": wins, "rate": wins / len(episodes), "ci95": [low, high]}
+
+
+def _median(values: list[float]) -> float | None:
+    return statistics.median(values) if values else None
+
+
+def _p95(values: list[float]) -> float | None:
+    if not values:
+        return None
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
+
+
+def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> dict[str, Any]:
+    """Everything ``bt-eval`` prints and saves, from the episodes' records."""
+    by: dict[str, dict[str, list[dict[str, Any]]]] = {"task": defaultdict(list), "object": defaultdict(list)}
+    by["fault"] = defaultdict(list)
+    for e in episodes:
+        by["task"][e["task"]].append(e)
+        by["object"][e["object"] or "-"].append(e)
+        by["fault"][e["fault"] or "none"].append(e)
+    done = [e for e in episodes if e["success"]]
+    sim = sum(e["sim_time"] for e in episodes)
+    busy = sum(e["wall_s"] for e in episodes)
+    latencies = [e["stop_latency_s"] for e in episodes if e["stop_latency_s"] is not None]
+    return {
+        "success": _rate(episodes),
+        "by_task": {k: _rate(v) for k, v in by["task"].items()},
+        "by_object": {k: _rate(v) for k, v in by["object"].items()},
+        "by_fault": {k: _rate(v) for k, v in by["fault"].items()},
+        "time_to_complete_s": {
+            "median": _median([e["sim_time"] for e in done]),
+            "p95": _p95([e["sim_time"] for e in done]),
+        },
+        "episodes_with_person_contact": sum(e["person_contacts"] > 0 for e in episodes),
+        "episodes_with_collision_stop": sum(e["collision"] for e in episodes),
+        "episodes_ended_moving": sum(e["ended_moving"] for e in episodes),
+        "stop_latency_s": {"median": _median(latencies), "p95": _p95(latencies), "count": len(latencies)},
+        "plan_ms_median": _median([t for e in episodes for t in e["plan_ms"]]),
+        "look_ms_median": _median([e["look_ms_median"] for e in episodes if e["look_ms_median"] is not None]),
+        "qp_ms_median": _median([e["qp_ms_median"] for e in episodes if e["qp_ms_median"] is not None]),
+        "qp_ms_p95_median": _median([e["qp_ms_p95"] for e in episodes if e["qp_ms_p95"] is not None]),
+        "real_time_factor_per_core": sim / busy if busy else None,
+        "wall_s": round(wall_s, 1),
+        "workers": workers,
+        "failures": [
+            {"episode": e["episode"], "task": e["command"], "fault": e["fault"], "failure": e["failure"]}
+            for e in episodes
+            if not e["success"]
+        ],
+    }
