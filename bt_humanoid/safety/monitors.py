@@ -70,28 +70,48 @@ class BumperMonitor:
     """Fires when the robot's trunk (base, torso, head: not the arms) touches anything but the floor.
 
     The arms touch tables and objects as their work; the trunk never should. This is the robot's own touch
-    sense (a bumper and skin), read from the contacts its geoms make; it does not say what was hit.
+    sense (a bumper and skin), read from the contacts its geoms make; it does not say what was hit. Its own
+    arms, and a loose thing the hands hold at the same time, are the robot and its load, not a collision.
     """
 
     name = "collision"
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, trunk: set[int]) -> None:
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, trunk: set[int], robot: set[int]) -> None:
         self.model, self.data = model, data
         self.on_trunk = np.isin(model.geom_bodyid, sorted(trunk))  # per geom
+        self.on_arms = np.isin(model.geom_bodyid, sorted(robot - trunk))  # per geom
+        self.own = self.on_trunk | self.on_arms
         self.floor = model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE  # per geom
+        free = np.zeros(model.nbody, dtype=bool)
+        free[model.jnt_bodyid[model.jnt_type == mujoco.mjtJoint.mjJNT_FREE]] = True
+        self.loose = free[model.geom_bodyid]  # per geom: on a free body (an object, a parcel)
 
     def check(self, now: float) -> str | None:
         contacts = self.data.contact
         pairs = np.stack([contacts.geom1, contacts.geom2], axis=1)  # (contacts, 2)
         mine = self.on_trunk[pairs]
-        hit = mine & ~mine[:, ::-1] & ~self.floor[pairs[:, ::-1]]  # trunk side, the other not trunk nor floor
+        other = pairs[:, ::-1]
+        hit = mine & ~self.own[other] & ~self.floor[other]  # trunk side; the other not the robot nor the floor
         rows, sides = np.nonzero(hit)
         if rows.size == 0:
             return None
-        geom = int(pairs[rows[0], sides[0]])
-        x, y = contacts.pos[rows[0], :2]
-        part = self.model.geom(geom).name or self.model.body(self.model.geom_bodyid[geom]).name
-        return f"the robot's {part} touched something at ({x:.2f}, {y:.2f})"
+        held = self._held_bodies(pairs)
+        for row, side in zip(rows, sides, strict=True):
+            other = int(pairs[row, 1 - side])
+            if self.model.geom_bodyid[other] in held:
+                continue
+            geom = int(pairs[row, side])
+            x, y = contacts.pos[row, :2]
+            part = self.model.geom(geom).name or self.model.body(self.model.geom_bodyid[geom]).name
+            return f"the robot's {part} touched something at ({x:.2f}, {y:.2f})"
+        return None
+
+    def _held_bodies(self, pairs: np.ndarray) -> set[int]:
+        """Loose bodies an arm or hand touches now."""
+        arm = self.on_arms[pairs]
+        loose = self.loose[pairs[:, ::-1]]
+        rows, sides = np.nonzero(arm & loose)
+        return {int(self.model.geom_bodyid[pairs[r, 1 - s]]) for r, s in zip(rows, sides, strict=True)}
 
 
 def trunk_bodies(model: mujoco.MjModel, root: int, hand_bodies: list[int]) -> set[int]:
