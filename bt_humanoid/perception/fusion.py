@@ -60,7 +60,7 @@ def _reidentify(belief: WorldModel) -> None:
 
     gone = [o for o in objects.values() if o.confidence <= 0.0 and o.held_by is None]
     for old in gone:
-        newcomers = [o for o in objects.values() if o.confidence > 0.0 and alike(o, old) and o.first_seen > old.last_seen]
+        newcomers = [o for o in objects.values() if o.confidence > 0 and alike(o, old) and o.first_seen > old.last_seen]
         if len(newcomers) != 1:
             continue
         new = newcomers[0]
