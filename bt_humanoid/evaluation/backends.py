@@ -30,10 +30,14 @@ def run_local(suite_file: str, indices: list[int], seed: int, workers: int) -> I
     """Episodes in ``workers`` processes (spawned: each has its own MuJoCo and renderers)."""
     if workers == 1:
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
-        if cores:
-            os.sched_setaffinity(0, {cores[0]})
-        for index in indices:
-            yield run_episode(suite_file, index, seed)
+        try:
+            if cores:
+                os.sched_setaffinity(0, {cores[0]})
+            for index in indices:
+                yield run_episode(suite_file, index, seed)
+        finally:
+            if cores:
+                os.sched_setaffinity(0, set(cores))
         return
     context = multiprocessing.get_context("spawn")
     cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []

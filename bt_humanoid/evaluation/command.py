@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -13,7 +14,7 @@ from rich.table import Table
 
 from bt_humanoid.cli import EXIT_OK, _fail_invalid, _Parser
 from bt_humanoid.errors import UserError
-from bt_humanoid.evaluation.report import summarize
+from bt_humanoid.evaluation.report import markdown, summarize
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.paths import missions_dir
 
@@ -21,6 +22,9 @@ from bt_humanoid.paths import missions_dir
 def _parser() -> _Parser:
     parser = _Parser(prog="bt-eval", description="Run a benchmark suite over randomized scenes and report.")
     parser.add_argument("suite", help="a suite YAML file, or the name of one in missions/benchmarks/ (e.g. fetch)")
+    parser.add_argument(
+        "--markdown", action="store_true", help="SUITE is a saved JSON run: print its README section, run nothing"
+    )
     parser.add_argument("--episodes", type=int, help="how many episodes (default: the suite's)")
     parser.add_argument("--seed", type=int, help="draws every scene (default: the suite's)")
     parser.add_argument("--workers", type=int, default=1, help="worker processes, one core each (default 1)")
@@ -40,6 +44,8 @@ def _suite_file(name: str) -> Path:
 def eval_main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     console = Console(highlight=False, soft_wrap=True)
+    if args.markdown:
+        return _print_markdown(Path(args.suite))
     try:
         if args.workers < 1:
             raise UserError(f"--workers {args.workers}: give 1 or more")
@@ -60,11 +66,21 @@ def eval_main(argv: list[str] | None = None) -> int:
         return _fail_invalid(error)
     records.sort(key=lambda r: r["episode"])
     figures = summarize(records, wall, args.workers)
-    figures = {"suite": suite.suite, "file": str(file), "seed": seed, **figures}
+    command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
+    figures = {"suite": suite.suite, "file": str(file), "seed": seed, "command": command, **figures}
     _print(console, figures)
     out = args.json or Path(f"bt-eval-{suite.suite}.json")
     out.write_text(json.dumps({**figures, "episodes": records}, indent=1) + "\n")
     console.print(f"wrote {out}")
+    return EXIT_OK
+
+
+def _print_markdown(saved: Path) -> int:
+    try:
+        figures = json.loads(saved.read_text())
+    except (OSError, ValueError) as error:
+        return _fail_invalid(UserError(f"not a saved bt-eval run: {error}", where=str(saved)))
+    print(markdown(figures, figures.get("command", f"bt-eval {figures['file']}")), end="")
     return EXIT_OK
 
 

@@ -61,8 +61,10 @@ class Draw:
         self.start_surface = str(rng.choice(suite.randomize.object_on)) if suite.randomize.object_on else None
         others = [s for s in suite.surfaces if s != self.start_surface] or suite.surfaces
         self.surface = str(rng.choice(others)) if others else ""
-        faulted = suite.faults.kinds and rng.uniform() < suite.faults.share
-        self.fault_index = int(rng.integers(len(suite.faults.kinds))) if faulted else None
+        kinds = len(suite.faults.kinds)
+        self.fault_index: int | None = None
+        if kinds and rng.uniform() < suite.faults.share:
+            self.fault_index = index % kinds if suite.faults.order == "cycle" else int(rng.integers(kinds))
         self.side_sign = float(rng.choice([-1.0, 1.0]))
         self.spare_spots: list[np.ndarray] = []  # filled at set-up: where a moved object may go
 
@@ -71,8 +73,13 @@ class Draw:
         return {"object": self.obj, "surface": self.surface}
 
 
-def run_episode(suite_file: str, index: int, seed: int | None = None) -> dict[str, Any]:
-    """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``); figures and verdict as a dict."""
+def run_episode(
+    suite_file: str, index: int, seed: int | None = None, events: list[dict[str, Any]] | None = None
+) -> dict[str, Any]:
+    """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``); figures and verdict as a dict.
+
+    ``events``, when given, receives the run's event log (tests look at how a fault was recovered from).
+    """
     started = time.perf_counter()
     suite = _suite(suite_file)
     if seed is not None:
@@ -91,6 +98,8 @@ def run_episode(suite_file: str, index: int, seed: int | None = None) -> dict[st
     run = _set_up(suite, draw, record)
     try:
         record |= _play(suite, suite_file, task, draw, fault, run)
+        if events is not None:
+            events.extend(run.events.events)
     finally:
         if run.perceiver is not None:
             run.perceiver.close()

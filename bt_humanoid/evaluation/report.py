@@ -76,3 +76,52 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
             if not e["success"]
         ],
     }
+
+
+def markdown(figures: dict[str, Any], command: str) -> str:
+    """The README's results section for one saved run: the command, the rates with intervals, the figures."""
+
+    def rate(r: dict[str, Any]) -> str:
+        low, high = r["ci95"]
+        return f"{r['rate']:.1%} | {low:.1%}–{high:.1%} | {r['successes']}/{r['episodes']}"
+
+    def number(value: float | None, digits: int = 1) -> str:
+        return f"{value:.{digits}f}" if value is not None else "–"
+
+    rows = ["| group | success | 95 % interval | episodes |", "| --- | --- | --- | --- |"]
+    rows.append(f"| all | {rate(figures['success'])} |")
+    for key, label in (("by_task", "task"), ("by_object", "object"), ("by_fault", "fault")):
+        rows += [f"| {label}: {name} | {rate(r)} |" for name, r in sorted(figures[key].items())]
+    done, latency = figures["time_to_complete_s"], figures["stop_latency_s"]
+    lines = [
+        f"Suite `{figures['suite']}` ({figures['file']}), seed {figures['seed']}, "
+        f"{figures['success']['episodes']} episodes, measured with",
+        "",
+        "```bash",
+        command,
+        "```",
+        "",
+        *rows,
+        "",
+        "| figure | measured |",
+        "| --- | --- |",
+        f"| time to complete, successful episodes | median {number(done['median'])} s, p95 {number(done['p95'])} s |",
+        f"| episodes in which the robot touched a person | {figures['episodes_with_person_contact']} |",
+        f"| episodes stopped by the bumper | {figures['episodes_with_collision_stop']} |",
+        f"| episodes that ended with the robot still moving | {figures['episodes_ended_moving']} |",
+        f"| stop latency, new command → at rest | median {number(latency['median'], 2)} s, "
+        f"p95 {number(latency['p95'], 2)} s ({latency['count']} episodes) |",
+        f"| planning, text → validated mission | median {number(figures['plan_ms_median'])} ms |",
+        f"| perception, one camera look | median {number(figures['look_ms_median'])} ms |",
+        f"| whole-body QP per control step | median {number(figures['qp_ms_median'], 3)} ms |",
+        f"| real-time factor, per core | {number(figures['real_time_factor_per_core'])}× |",
+        f"| wall time | {figures['wall_s'] / 60:.1f} min with {figures['workers']} worker(s) |",
+    ]
+    failures = figures["failures"]
+    if failures:
+        lines += ["", "Episodes that failed, and why:", ""]
+        lines += [
+            f"- {f['episode']}: {f['task']}{' (fault: ' + f['fault'] + ')' if f['fault'] else ''} — {f['failure']}"
+            for f in failures
+        ]
+    return "\n".join(lines) + "\n"

@@ -56,6 +56,9 @@ class Randomize(StrictModel):
 class FaultPlan(StrictModel):
     share: float = Field(0.0, ge=0, le=1, description="fraction of episodes that get one injected fault")
     kinds: list[FaultConfig] = Field(default_factory=list, description="faults to draw from, one per faulted episode")
+    order: Literal["random", "cycle"] = Field(
+        "random", description="draw a kind at random, or take them in turn (episode i gets kind i mod N)"
+    )
 
     @model_validator(mode="after")
     def _kinds_when_shared(self) -> FaultPlan:

@@ -1,0 +1,159 @@
+"""bt-eval: suites, episode draws, the report's statistics, the smoke suite, and the Ray backend."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from bt_humanoid.errors import UserError
+from bt_humanoid.evaluation.command import eval_main
+from bt_humanoid.evaluation.episode import Draw
+from bt_humanoid.evaluation.report import summarize, wilson_interval
+from bt_humanoid.evaluation.suite import load_suite
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "missions" / "benchmarks"
+
+
+def test_wilson_interval_matches_published_values():
+    # Wilson score intervals (z = 1.96), as in Brown, Cai & DasGupta (2001)
+    assert wilson_interval(50, 100) == pytest.approx((0.4038, 0.5962), abs=1e-4)
+    assert wilson_interval(0, 10) == pytest.approx((0.0, 0.2775), abs=1e-4)
+    assert wilson_interval(10, 10) == pytest.approx((0.7225, 1.0), abs=1e-4)
+    low, high = wilson_interval(190, 200)
+    assert low < 0.95 < high and high - low < 0.07
+
+
+@pytest.mark.parametrize("name", ["fetch", "faults", "smoke"])
+def test_every_suite_in_the_repository_is_valid(name):
+    suite, world = load_suite(BENCHMARKS / f"{name}.yaml")
+    assert suite.episodes >= 1 and world.name == suite.world
+
+
+def test_the_fetch_suite_meets_the_issue_s_shape():
+    suite, _ = load_suite(BENCHMARKS / "fetch.yaml")
+    assert suite.episodes >= 200
+    assert len(set(suite.objects)) >= 3
+    assert suite.faults.share >= 0.2
+    kinds = {fault.kind for fault in suite.faults.kinds}
+    assert kinds == {"slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command"}
+
+
+def test_draws_follow_from_the_seed_and_index_alone():
+    suite, _ = load_suite(BENCHMARKS / "fetch.yaml")
+    later = [Draw(suite, i) for i in (7, 3, 5)]  # another order, as another worker would draw them
+    by_index = {i: Draw(suite, i) for i in (3, 5, 7)}
+    for i, draw in zip((7, 3, 5), later, strict=True):
+        same = by_index[i]
+        assert (draw.obj, draw.task_index, draw.fault_index, draw.surface) == (
+            same.obj,
+            same.task_index,
+            same.fault_index,
+            same.surface,
+        )
+        assert draw.rng.uniform() == same.rng.uniform()
+    faulted = sum(Draw(suite, i).fault_index is not None for i in range(suite.episodes))
+    assert 0.12 * suite.episodes < faulted < 0.28 * suite.episodes  # share 0.2, drawn
+
+
+def _suite(tmp_path: Path, text: str) -> Path:
+    file = tmp_path / "suite.yaml"
+    file.write_text(text)
+    return file
+
+
+def test_an_unknown_object_is_reported_at_its_line(tmp_path):
+    file = _suite(
+        tmp_path,
+        "suite: s\nobjects: [red cube, banana]\ntasks:\n  - command: bring me the {object}\n"
+        "    expect: [{delivered: '{object}'}]\n",
+    )
+    with pytest.raises(UserError) as error:
+        load_suite(file)
+    assert "suite.yaml:2" in str(error.value) and "banana" in str(error.value) and "red cube" in str(error.value)
+
+
+def test_a_command_task_without_expectations_is_refused(tmp_path):
+    file = _suite(tmp_path, "suite: s\nobjects: [red cube]\ntasks:\n  - command: bring me the {object}\n")
+    with pytest.raises(UserError, match="needs expect"):
+        load_suite(file)
+
+
+def test_an_unknown_fault_kind_names_the_valid_ones(tmp_path):
+    file = _suite(
+        tmp_path,
+        "suite: s\nobjects: [red cube]\ntasks:\n  - command: bring me the {object}\n"
+        "    expect: [{delivered: '{object}'}]\nfaults:\n  share: 0.5\n  kinds:\n    - earthquake: {}\n",
+    )
+    with pytest.raises(UserError) as error:
+        load_suite(file)
+    assert "suite.yaml:9" in str(error.value) and "earthquake" in str(error.value)
+
+
+def test_bt_eval_exits_2_with_one_line_for_bad_input(tmp_path, capsys):
+    assert eval_main([str(tmp_path / "missing.yaml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "missing.yaml" in err and "not found" in err
+    assert eval_main(["smoke", "--workers", "0"]) == 2
+    assert "--workers 0" in capsys.readouterr().err
+
+
+def test_summary_counts_what_the_episodes_report():
+    def episode(i: int, success: bool, fault: str | None, contacts: int = 0) -> dict:
+        return {
+            "episode": i,
+            "task": "bring me the {object}",
+            "command": "bring me the red cube",
+            "object": "red cube",
+            "fault": fault,
+            "success": success,
+            "failure": None if success else "safety stop: collision",
+            "sim_time": 60.0,
+            "wall_s": 10.0,
+            "person_contacts": contacts,
+            "collision": not success,
+            "ended_moving": False,
+            "plan_ms": [30.0],
+            "stop_latency_s": 0.4 if fault == "new_command" else None,
+            "look_ms_median": 25.0,
+            "qp_ms_median": 0.4,
+            "qp_ms_p95": 0.6,
+        }
+
+    episodes = [episode(0, True, None), episode(1, False, "push", contacts=3), episode(2, True, "new_command")]
+    figures = summarize(episodes, wall_s=20.0, workers=2)
+    assert figures["success"]["successes"] == 2 and figures["success"]["episodes"] == 3
+    assert figures["by_fault"]["push"]["rate"] == 0.0
+    assert figures["episodes_with_person_contact"] == 1
+    assert figures["episodes_with_collision_stop"] == 1
+    assert figures["stop_latency_s"]["count"] == 1
+    assert figures["real_time_factor_per_core"] == pytest.approx(6.0)
+    assert [f["episode"] for f in figures["failures"]] == [1]
+
+
+def test_the_smoke_suite_runs_end_to_end(tmp_path, capsys):
+    out = tmp_path / "smoke.json"
+    affinity = os.sched_getaffinity(0)
+    assert eval_main(["smoke", "--json", str(out)]) == 0
+    assert os.sched_getaffinity(0) == affinity, "one worker pins itself to a core, and lets go afterwards"
+    report = json.loads(out.read_text())
+    assert len(report["episodes"]) == 2
+    assert report["success"]["successes"] == 2, report["failures"]
+    assert report["episodes_with_person_contact"] == 0 and report["episodes_ended_moving"] == 0
+    assert report["real_time_factor_per_core"] > 1.0
+    printed = capsys.readouterr().out
+    assert "success with 95 % confidence interval" in printed and "real-time factor per core" in printed
+
+
+def test_the_ray_backend_runs_episodes_on_a_local_ray_instance():
+    ray = pytest.importorskip("ray")
+    from bt_humanoid.evaluation.backends import run_ray
+
+    try:
+        records = list(run_ray(str(BENCHMARKS / "smoke.yaml"), [1], 3, None))
+    finally:
+        ray.shutdown()
+    assert [r["episode"] for r in records] == [1]
+    assert records[0]["success"], records[0]["failure"]

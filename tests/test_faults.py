@@ -1,0 +1,84 @@
+"""Every injected fault kind ends in recovery or a safe stop (missions/benchmarks/faults.yaml, one episode each).
+
+The episode is "bring me the red cube" from the world's start; episode i gets fault kind i (the suite takes
+them in turn). Each test checks that the fault really happened, that the robot then did the job (judged in
+ground truth) and ended at rest without touching anyone, and how it got there, from the event log.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from bt_humanoid.evaluation.episode import run_episode
+
+SUITE = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "faults.yaml")
+KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command"]
+
+
+def _episode(kind: str) -> tuple[dict, list[dict]]:
+    events: list[dict] = []
+    record = run_episode(SUITE, KINDS.index(kind), events=events)
+    assert record["fault"] == kind
+    assert record["fault_fired"], f"the {kind} fault never found its moment"
+    assert record["person_contacts"] == 0 and not record["ended_moving"]
+    return record, events
+
+
+def _failures(events: list[dict]) -> list[str]:
+    return [e.get("feedback", "") for e in events if e["event"] == "status" and e["new"] == "FAILURE"]
+
+
+def _fault_time(events: list[dict]) -> float:
+    return next(e["t"] for e in events if e["event"] == "fault")
+
+
+def test_an_object_that_slips_out_of_the_fingers_is_grasped_again():
+    record, events = _episode("slip")
+    assert record["success"], record["failure"]
+    assert any("slipped out" in message for message in _failures(events)), "the grasp noticed the slip"
+
+
+def test_an_object_moved_during_the_approach_is_found_where_it_now_is():
+    record, events = _episode("target_moved")
+    assert record["success"], record["failure"]
+    status = [e for e in events if e["event"] == "status"]
+    picked = [e["t"] for e in status if e["node"].endswith(".pick") and e["new"] == "SUCCESS"]
+    assert picked and picked[-1] > _fault_time(events), "picked up after it was moved"
+
+
+def test_a_parcel_dropped_on_the_way_is_seen_and_driven_round():
+    record, _ = _episode("obstacle_dropped")
+    assert record["success"], record["failure"]
+    assert not record["collision"]
+
+
+def test_a_shove_while_driving_is_recovered_from():
+    record, _ = _episode("push")
+    assert record["success"], record["failure"]
+    assert not record["collision"]
+
+
+def test_a_camera_that_goes_blind_for_seconds_is_ridden_out():
+    record, _ = _episode("blind")
+    assert record["success"], record["failure"]
+
+
+def test_a_new_command_mid_mission_stops_the_robot_and_is_done_instead():
+    record, events = _episode("new_command")
+    assert record["success"], record["failure"]
+    assert record["stop_latency_s"] is not None and record["stop_latency_s"] < 1.0
+    said = [e["text"] for e in events if e["event"] == "say"]
+    assert "I have stopped." in said
+    missions = [e["mission"] for e in events if e["event"] == "start"]
+    assert missions[-1].startswith("put the red cube on the table"), missions
+    assert _fault_time(events) < max(e["t"] for e in events if e["event"] == "start")
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_suite_takes_fault_kinds_in_turn(kind):
+    from bt_humanoid.evaluation.episode import Draw, _suite
+
+    suite = _suite(SUITE)
+    assert suite.faults.kinds[Draw(suite, KINDS.index(kind)).fault_index].kind == kind
