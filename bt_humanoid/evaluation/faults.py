@@ -39,7 +39,7 @@ SPARE_BOX = "parcel"  # the free box in a corner of the apartment that obstacle_
 
 class SlipSettings(StrictModel):
     friction: float = Field(0.02, gt=0, le=1, description="the object's friction while slippery")
-    seconds: float = Field(1.0, gt=0, le=10, description="how long it stays slippery")
+    seconds: float = Field(1.0, gt=0, le=10, description="how long it stays slippery (at most: until it is out)")
     lifted: float = Field(0.02, gt=0, le=0.2, description="m above where it rested when the slip starts")
 
 
@@ -162,6 +162,7 @@ class Slip(Injector):
         self.obj, self.settings = obj, settings
         self.geoms = _object_geoms(run, obj)
         self.friction = run.sim.model.geom_friction[self.geoms].copy()
+        self.priority = run.sim.model.geom_priority[self.geoms].copy()
         self.rest_height = float(run.truth.object_position(obj)[2])
         self.dried = False
 
@@ -169,12 +170,16 @@ class Slip(Injector):
         truth = self.run.truth
         lifted = truth.object_position(self.obj)[2] - self.rest_height
         if lifted > self.settings.lifted and truth.in_hand(self.obj) is not None:
-            self.run.sim.model.geom_friction[self.geoms, 0] = self.settings.friction
+            model = self.run.sim.model
+            model.geom_friction[self.geoms, 0] = self.settings.friction
+            model.geom_priority[self.geoms] = 100  # its friction wins over the pads' (else MuJoCo takes the larger)
             self.fire(f"the {self.obj} turned slippery {lifted * 100:.0f} cm above where it rested")
 
     def after(self) -> None:
-        if not self.dried and self.run.sim.time > self.fired.time + self.settings.seconds:
+        out_of_hand = self.run.truth.in_hand(self.obj) is None  # slippery fingers, not a slippery table
+        if not self.dried and (out_of_hand or self.run.sim.time > self.fired.time + self.settings.seconds):
             self.run.sim.model.geom_friction[self.geoms] = self.friction
+            self.run.sim.model.geom_priority[self.geoms] = self.priority
             self.dried = True
 
 
