@@ -96,6 +96,9 @@ class StandNearParams(StrictModel):
         return self
 
 
+STANCE_ARRIVAL = 0.15  # m: the first and last stretch at a stance may graze the map's margin round furniture
+
+
 @skill("stand_near", "drive (straight, short) to a stance from which one hand reaches an object or a surface spot")
 class StandNear(_ManipulationSkill):
     Params = StandNearParams
@@ -155,7 +158,22 @@ class StandNear(_ManipulationSkill):
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
         speed = min(p.max_speed, self.context.max_base_speed)
+        if self._straight_way_blocked(np.array([x, y])):  # the object moved, or we stand on another side
+            return self.context.navigator.go_to(np.array([x, y, yaw]), speed)
         return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
+
+    def _straight_way_blocked(self, stance: np.ndarray) -> bool:
+        """Would the footprint, driven straight to ``stance``, cross furniture on the map before it arrives?"""
+        navigator = self.context.navigator
+        if navigator is None:
+            return False
+        here = self.context.robot.base.pose()[:2]
+        length = float(np.hypot(*(stance - here)))
+        steps = np.arange(STANCE_ARRIVAL, length - STANCE_ARRIVAL, navigator.grid.resolution)
+        if steps.size == 0:
+            return False
+        points = here + steps[:, None] * (stance - here) / max(length, 1e-9)
+        return bool(np.min(navigator.grid.clearance_at(points)) < self.context.robot_config.base.footprint_radius)
 
 
 # --------------------------------------------------------------------------- grasp

@@ -170,8 +170,16 @@ class NavigateTo(_BaseSkill):
                 x, y, yaw = stance_for(obj.position[:2], surface, "right", radius, bounds, here[:2])
             except StanceError as error:
                 raise PhaseFailure(str(error)) from None
-            # a step back from the working stance: room to raise the arms before the last approach (stand_near)
-            return np.array([x - STANCE_BACKOFF * math.cos(yaw), y - STANCE_BACKOFF * math.sin(yaw), yaw])
+            # a step back from the working stance: room to raise the arms before the last approach (stand_near),
+            # shorter where furniture behind leaves less room
+            back = np.array([math.cos(yaw), math.sin(yaw)])
+            options = [np.array([x, y]) - step * back for step in np.linspace(STANCE_BACKOFF, 0.0, 5)]
+            navigator = self.context.navigator
+            if navigator is not None:
+                room = navigator.grid.clearance_at(np.array(options))
+                fits = [xy for xy, free in zip(options, room, strict=True) if free >= navigator.clearance.minimum]
+                options = fits or options
+            return np.array([*options[0], yaw])
         return self._facing(obj.position, OBJECT_STANDOFF)
 
 
