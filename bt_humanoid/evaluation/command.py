@@ -17,6 +17,7 @@ from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation.report import markdown, summarize
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.paths import missions_dir
+from bt_humanoid.yaml_source import display_path
 
 
 def _parser() -> _Parser:
@@ -67,7 +68,7 @@ def eval_main(argv: list[str] | None = None) -> int:
     records.sort(key=lambda r: r["episode"])
     figures = summarize(records, wall, args.workers)
     command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
-    figures = {"suite": suite.suite, "file": str(file), "seed": seed, "command": command, **figures}
+    figures = {"suite": suite.suite, "file": display_path(file), "seed": seed, "command": command, **figures}
     _print(console, figures)
     out = args.json or Path(f"bt-eval-{suite.suite}.json")
     out.write_text(json.dumps({**figures, "episodes": records}, indent=1) + "\n")
