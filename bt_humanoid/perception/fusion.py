@@ -69,6 +69,7 @@ def _reidentify(belief: WorldModel) -> None:
         for name in ("position", "yaw", "yaw_known", "size", "confidence", "last_seen", "first_seen", "votes"):
             setattr(old, name, getattr(new, name))
         del objects[new.id]
+        belief.merged[new.id] = old.id
 
 
 def _nearest(belief: WorldModel, detection: Detection) -> TrackedObject | None:
@@ -81,7 +82,8 @@ def _nearest(belief: WorldModel, detection: Detection) -> TrackedObject | None:
 
 
 def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject:
-    number = 1 + sum(1 for o in belief.objects.values() if o.id.startswith(f"{detection.kind}-"))
+    used = [*belief.objects, *belief.merged]  # a merged sighting's id stays taken: plans may still name it
+    number = 1 + sum(1 for key in used if key.startswith(f"{detection.kind}-"))
     tracked = TrackedObject(
         id=f"{detection.kind}-{number}",
         name=f"{detection.colour} {detection.kind}",

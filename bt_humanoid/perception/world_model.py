@@ -69,12 +69,14 @@ class WorldModel:
     people: dict[str, np.ndarray] = field(default_factory=dict)  # name or alias → position (m)
     rooms: dict[str, np.ndarray] = field(default_factory=dict)  # name → [[x_min, y_min], [x_max, y_max]] (m)
     vocabulary: dict[str, tuple[str, str]] = field(default_factory=dict)  # what people call things → (kind, colour)
+    merged: dict[str, str] = field(default_factory=dict)  # id of a sighting found to be a known object → its id
 
     def object(self, name: str) -> TrackedObject:
         """An object by id, by name, or by what people call it (the vocabulary: "water bottle" is a blue bottle).
 
         Objects believed gone (confidence 0) are only found by id.
         """
+        name = self.merged.get(name, name)  # a plan may hold the id a sighting had before it was recognised
         if name in self.objects:
             return self.objects[name]
         present = self.present()
