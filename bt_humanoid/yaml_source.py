@@ -40,6 +40,11 @@ class YamlSource:
         line = self.lines.get(probe, 1)
         return f"{display_path(self.file)}:{line}"
 
+    def invalid(self, error: ValidationError, base: YamlPath = (), prefix: str = "") -> UserError:
+        """A pydantic error on the value at ``base``, phrased for people, at the file:line of its first problem."""
+        location, message = describe_validation_error(error)
+        return UserError(f"{prefix}{message}", where=self.where((*base, *location)))
+
 
 def read_yaml(file: Path, text: str | None = None) -> YamlSource:
     """Parse one YAML document; syntax errors become UserErrors at file:line."""
@@ -101,8 +106,7 @@ def read_config(
     try:
         return model.model_validate({**(data or {}), "folder": path.parent})
     except ValidationError as error:
-        location, message = describe_validation_error(error)
-        raise UserError(message, where=source.where(location)) from None
+        raise source.invalid(error) from None
 
 
 def _convert(loader: yaml.SafeLoader, node: yaml.Node, path: YamlPath, source: YamlSource) -> Any:

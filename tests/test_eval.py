@@ -81,6 +81,24 @@ def test_a_command_task_without_expectations_is_refused(tmp_path):
         load_suite(file)
 
 
+@pytest.mark.parametrize(
+    ("faults", "line"),
+    [
+        ("", 5),  # a task's expectation
+        ("faults:\n  share: 1\n  kinds:\n    - new_command: {command: wave, expect: [{on: [red cube, floor]}]}\n", 9),
+    ],
+)
+def test_an_expectation_naming_an_unknown_surface_is_reported_at_its_line(tmp_path, faults, line):
+    expect = "[{on: ['{object}', floor]}]" if not faults else "[{delivered: '{object}'}]"
+    file = _suite(
+        tmp_path,
+        f"suite: s\nobjects: [red cube]\ntasks:\n  - command: bring me the {{object}}\n    expect: {expect}\n{faults}",
+    )
+    with pytest.raises(UserError) as error:
+        load_suite(file)
+    assert f"suite.yaml:{line}" in str(error.value) and "unknown name 'floor'" in str(error.value)
+
+
 def test_an_unknown_fault_kind_names_the_valid_ones(tmp_path):
     file = _suite(
         tmp_path,

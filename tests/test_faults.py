@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from bt_humanoid.evaluation.episode import run_episode
+from bt_humanoid.evaluation.episode import Draw, run_episode
+from bt_humanoid.evaluation.suite import load_suite
 
 SUITE = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "faults.yaml")
 KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command"]
@@ -78,7 +79,5 @@ def test_a_new_command_mid_mission_stops_the_robot_and_is_done_instead():
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_the_suite_takes_fault_kinds_in_turn(kind):
-    from bt_humanoid.evaluation.episode import Draw, _suite
-
-    suite = _suite(SUITE)
+    suite, _ = load_suite(Path(SUITE))
     assert suite.faults.kinds[Draw(suite, KINDS.index(kind)).fault_index].kind == kind

@@ -132,7 +132,7 @@ class MissionRun:
             self.stop_monitor,
             JointLimitMonitor(self.robot, margin),
             TimeBudgetMonitor(self.time_budget, self.sim.time),
-            BumperMonitor(self.sim.model, self.sim.data, self._trunk(), self._own_bodies()),
+            BumperMonitor(self.sim.model, self.sim.data, self._trunk(), self.sim.robot_bodies),
         ]
         self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time)
 
@@ -148,13 +148,7 @@ class MissionRun:
         """The robot's bodies that are not on an arm: what the bumper monitor watches."""
         model = self.sim.model
         hands = [int(model.jnt_bodyid[model.joint(j).id]) for g in self.sim.robot.grippers.values() for j in g.joints]
-        return trunk_bodies(model, int(model.body_rootid[hands[0]]), hands) if hands else set()
-
-    def _own_bodies(self) -> set[int]:
-        """Every body of the robot (the tree under its base)."""
-        model = self.sim.model
-        root = model.body_rootid[model.body("base").id]
-        return {b for b in range(model.nbody) if model.body_rootid[b] == root}
+        return trunk_bodies(model, self.sim.robot_bodies, hands) if hands else set()
 
     def follow_with(self, spec: MissionSpec) -> None:
         """Make ``spec`` the next mission, from where the last one left the robot and the world (and the belief)."""

@@ -27,9 +27,9 @@ def _pin_worker(cores: list[int], counter) -> None:
 
 
 def run_local(suite_file: str, indices: list[int], seed: int, workers: int) -> Iterator[dict[str, Any]]:
-    """Episodes in ``workers`` processes (spawned: each has its own MuJoCo and renderers)."""
+    """Episodes in ``workers`` processes (spawned: each has its own MuJoCo and renderers), or in this one."""
+    cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
     if workers == 1:
-        cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
         try:
             if cores:
                 os.sched_setaffinity(0, {cores[0]})
@@ -40,7 +40,6 @@ def run_local(suite_file: str, indices: list[int], seed: int, workers: int) -> I
                 os.sched_setaffinity(0, set(cores))
         return
     context = multiprocessing.get_context("spawn")
-    cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
     counter = context.Value("i", 0)
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_pin_worker, initargs=(cores, counter)) as pool:
         futures = [pool.submit(run_episode, suite_file, index, seed) for index in indices]

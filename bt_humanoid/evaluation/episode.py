@@ -122,32 +122,24 @@ def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> MissionRun:
         mujoco.mj_forward(model, run.sim.data)
         run.navigator.remap()
     record["start"] = list(start) if start else None
-    if draw.start_surface is not None and draw.obj:
-        surface = run.context.world_model.surface(draw.start_surface)
-        others = [run.truth.object_position(o) for o in world.objects if o != draw.obj]
-        footprint = run.context.robot_config.base.footprint_radius
-        spot = reachable_spot(surface, probe.navigator.grid, footprint, np.array(world.bounds), others, rng)
-        place_object(run, draw.obj, float(spot[0]), float(spot[1]), float(rng.uniform(-math.pi, math.pi)))
-        record["object_at"] = [draw.start_surface, round(float(spot[0]), 3), round(float(spot[1]), 3)]
-    draw.spare_spots = _spare_spots(run, draw, probe)
-    return run
-
-
-def _spare_spots(run: MissionRun, draw: Draw, probe: MissionRun) -> list[np.ndarray]:
-    """Free reachable spots on the object's surface, for a fault that moves it."""
     if draw.start_surface is None or not draw.obj:
-        return []
+        return run
     surface = run.context.world_model.surface(draw.start_surface)
-    footprint = run.context.robot_config.base.footprint_radius
-    others = [run.truth.object_position(o) for o in run.context.world.objects]
-    bounds = np.array(run.context.world.bounds)
-    spots = []
-    for _ in range(5):
+    footprint, bounds = run.context.robot_config.base.footprint_radius, np.array(world.bounds)
+
+    def spot_among(others: list[np.ndarray]) -> np.ndarray:
+        return reachable_spot(surface, probe.navigator.grid, footprint, bounds, others, rng)
+
+    spot = spot_among([run.truth.object_position(o) for o in world.objects if o != draw.obj])
+    place_object(run, draw.obj, float(spot[0]), float(spot[1]), float(rng.uniform(-math.pi, math.pi)))
+    record["object_at"] = [draw.start_surface, round(float(spot[0]), 3), round(float(spot[1]), 3)]
+    others = [run.truth.object_position(o) for o in world.objects]  # the object included, where it now stands
+    for _ in range(5):  # spots a fault may move it to
         try:
-            spots.append(reachable_spot(surface, probe.navigator.grid, footprint, bounds, others + spots, draw.rng))
+            draw.spare_spots.append(spot_among(others + draw.spare_spots))
         except ValueError:
             break
-    return spots
+    return run
 
 
 def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, run: MissionRun) -> dict[str, Any]:
@@ -161,16 +153,16 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, run: Mis
         return _verdict(run, None, expect, figures, failure=spec)
     run.follow_with(spec)
     injector = _arm(fault, run, draw) if fault is not None else None
-    people = run.truth.people_bodies()
+    model = run.sim.model
+    on_person = np.isin(model.geom_bodyid, sorted(run.truth.people_bodies()))  # per geom
+    on_robot = np.isin(model.geom_bodyid, sorted(run.sim.robot_bodies))  # per geom
     touched: list[float] = []
 
-    def watch_people() -> None:
-        for contact in run.sim.data.contact:
-            b1, b2 = run.sim.model.geom_bodyid[contact.geom1], run.sim.model.geom_bodyid[contact.geom2]
-            robot = run.truth.robot_bodies
-            if (b1 in people and b2 in robot) or (b2 in people and b1 in robot):
-                touched.append(run.sim.time)
-                return
+    def watch_people() -> None:  # every control step: vectorised over the contacts
+        contacts = run.sim.data.contact
+        g1, g2 = contacts.geom1, contacts.geom2
+        if np.any((on_person[g1] & on_robot[g2]) | (on_person[g2] & on_robot[g1])):
+            touched.append(run.sim.time)
 
     run.executor.observers.append(watch_people)
     result = run.execute(keep_open=True)

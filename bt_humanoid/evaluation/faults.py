@@ -25,9 +25,9 @@ from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
-from bt_humanoid.strict_model import StrictModel
+from bt_humanoid.strict_model import StrictModel, exactly_one
 
 if TYPE_CHECKING:
     from bt_humanoid.engine.runner import MissionRun
@@ -88,10 +88,10 @@ class FaultConfig(StrictModel):
     blind: BlindSettings | None = None
     new_command: NewCommandSettings | None = None
 
-    def model_post_init(self, context: Any) -> None:
-        given = [kind for kind in FAULT_MODELS if getattr(self, kind) is not None]
-        if len(given) != 1:
-            raise ValueError(f"give exactly one fault kind: {', '.join(FAULT_MODELS)}")
+    @model_validator(mode="after")
+    def _one_kind(self) -> FaultConfig:
+        exactly_one(self, *FAULT_MODELS)
+        return self
 
     @property
     def kind(self) -> str:
@@ -176,8 +176,10 @@ class Slip(Injector):
             self.fire(f"the {self.obj} turned slippery {lifted * 100:.0f} cm above where it rested")
 
     def after(self) -> None:
+        if self.dried:
+            return
         out_of_hand = self.run.truth.in_hand(self.obj) is None  # slippery fingers, not a slippery table
-        if not self.dried and (out_of_hand or self.run.sim.time > self.fired.time + self.settings.seconds):
+        if out_of_hand or self.run.sim.time > self.fired.time + self.settings.seconds:
             self.run.sim.model.geom_friction[self.geoms] = self.friction
             self.run.sim.model.geom_priority[self.geoms] = self.priority
             self.dried = True
@@ -189,7 +191,7 @@ class TargetMoved(Injector):
     def __init__(self, run: MissionRun, obj: str, settings: TargetMovedSettings, spots: list[np.ndarray]) -> None:
         super().__init__(run)
         self.obj, self.settings = obj, settings
-        self.spots = spots  # reachable free (x, y) spots on surfaces, from the episode's scene sampler
+        self.spots = spots  # reachable free (x, y) spots on the object's surface, from the episode's scene draw
 
     def watch(self) -> None:
         truth = self.run.truth
@@ -199,16 +201,14 @@ class TargetMoved(Injector):
         if not (near and self.driving() and truth.in_hand(self.obj) is None):
             return
         surface = self.run.context.world_model.surface_under(position + np.array([0, 0, 0.5]))
-        options = [
-            s
-            for s in self.spots
-            if np.hypot(*(s[:2] - position[:2])) >= self.settings.distance
-            and surface is not None
-            and surface.contains(s[:2])
+        if surface is None:
+            return  # not on a surface now (fallen): nobody would put it back for us
+        far_enough = [
+            s for s in self.spots if np.hypot(*(s[:2] - position[:2])) >= self.settings.distance and surface.contains(s)
         ]
-        if not options:
+        if not far_enough:
             return
-        spot = options[0]
+        spot = far_enough[0]
         body = self.run.context.world.objects[self.obj].body
         move_free_body(self.run, body, np.array([spot[0], spot[1], position[2] + 0.002]))
         self.fire(f"the {self.obj} was moved {np.hypot(*(spot[:2] - position[:2])):.2f} m")
@@ -222,8 +222,8 @@ class ObstacleDropped(Injector):
         self.settings = settings
         model = run.sim.model
         self.box = model.body(SPARE_BOX).id  # KeyError: the world has no spare box
-        geom = model.body_geomadr[self.box]
-        self.half = float(model.geom_size[geom][:2].max())
+        size = model.geom_size[model.body_geomadr[self.box]]
+        self.half, self.height = float(size[:2].max()), float(size[2])
 
     def watch(self) -> None:
         if not self.driving():
@@ -234,8 +234,7 @@ class ObstacleDropped(Injector):
         spot = np.array([x, y]) + self.settings.ahead * heading
         if not self._fair(spot):
             return
-        height = self.run.sim.model.geom_size[self.run.sim.model.body_geomadr[self.box]][2]
-        move_free_body(self.run, SPARE_BOX, np.array([*spot, height + 0.01]))
+        move_free_body(self.run, SPARE_BOX, np.array([*spot, self.height + 0.01]))
         self.fire(f"a box landed {self.settings.ahead:.1f} m ahead, at ({spot[0]:.2f}, {spot[1]:.2f})")
 
     def _fair(self, spot: np.ndarray) -> bool:

@@ -7,6 +7,8 @@ import statistics
 from collections import defaultdict
 from typing import Any
 
+from bt_humanoid.benchmarks.common import percentile
+
 Z95 = 1.959964  # two-sided 95 % normal quantile
 
 
@@ -32,20 +34,20 @@ def _median(values: list[float]) -> float | None:
 
 
 def _p95(values: list[float]) -> float | None:
-    if not values:
-        return None
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, round(0.95 * (len(ordered) - 1)))]
+    return percentile(values, 0.95) if values else None
+
+
+def _groups(episodes: list[dict[str, Any]], key: str, missing: str) -> dict[str, list[dict[str, Any]]]:
+    grouped: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for e in episodes:
+        grouped[e[key] or missing].append(e)
+    return grouped
 
 
 def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> dict[str, Any]:
     """Everything ``bt-eval`` prints and saves, from the episodes' records."""
-    by: dict[str, dict[str, list[dict[str, Any]]]] = {"task": defaultdict(list), "object": defaultdict(list)}
-    by["fault"] = defaultdict(list)
-    for e in episodes:
-        by["task"][e["task"]].append(e)
-        by["object"][e["object"] or "-"].append(e)
-        by["fault"][e["fault"] or "none"].append(e)
+    by = {"task": _groups(episodes, "task", "-"), "object": _groups(episodes, "object", "-")}
+    by["fault"] = _groups(episodes, "fault", "none")
     done = [e for e in episodes if e["success"]]
     sim = sum(e["sim_time"] for e in episodes)
     busy = sum(e["wall_s"] for e in episodes)

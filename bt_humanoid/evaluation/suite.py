@@ -15,9 +15,9 @@ from typing import Any, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from bt_humanoid.errors import UserError, describe_validation_error
+from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.evaluation.faults import FAULT_MODELS, FaultConfig
-from bt_humanoid.mission.schema import MissionHeader
+from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.strict_model import StrictModel, exactly_one
 from bt_humanoid.yaml_source import YamlSource, read_yaml
@@ -90,11 +90,10 @@ def load_suite(file: Path) -> tuple[Suite, WorldConfig]:
     try:
         suite = Suite.model_validate(source.data)
     except ValidationError as error:
-        location, message = describe_validation_error(error)
-        raise UserError(message, where=source.where(location)) from None
+        raise source.invalid(error) from None
     world = _world(suite, source)
     _check_names(suite, world, source)
-    _check_tasks(suite, world, source)
+    _check_tasks(suite, source)
     return suite, world
 
 
@@ -106,40 +105,44 @@ def _world(suite: Suite, source: YamlSource) -> WorldConfig:
 
 
 def _check_names(suite: Suite, world: WorldConfig, source: YamlSource) -> None:
-    from bt_humanoid.errors import did_you_mean
-
     checks = [
-        ("objects", suite.objects, world.objects),
-        ("surfaces", suite.surfaces, world.surfaces),
+        (("objects",), suite.objects, world.objects),
+        (("surfaces",), suite.surfaces, world.surfaces),
         (("randomize", "object_on"), suite.randomize.object_on, world.surfaces),
         (("randomize", "obstacles"), suite.randomize.obstacles, world.obstacles),
     ]
-    for key, names, known in checks:
-        path = key if isinstance(key, tuple) else (key,)
+    for path, names, known in checks:
         for index, name in enumerate(names):
             if name not in known:
-                raise UserError(
-                    f"unknown name '{name}'", where=source.where((*path, index)), hint=did_you_mean(name, known)
-                )
+                hint = did_you_mean(name, known)
+                raise UserError(f"unknown name '{name}'", where=source.where((*path, index)), hint=hint)
 
 
-def _check_tasks(suite: Suite, world: WorldConfig, source: YamlSource) -> None:
-    """Every task fills its slots and its expectations are valid conditions, for the first names drawn."""
-    slots = {"object": (suite.objects or [""])[0], "surface": (suite.surfaces or [""])[0]}
+def _check_tasks(suite: Suite, source: YamlSource) -> None:
+    """Every task fills its slots, and its expectations (and a new command's) are valid conditions on the world."""
     for index, task in enumerate(suite.tasks):
-        where = source.where(("tasks", index))
         text = task.command or ""
         for slot, names in (("object", suite.objects), ("surface", suite.surfaces)):
             if "{" + slot + "}" in text + str(task.expect) and not names:
-                raise UserError(f"the task uses {{{slot}}} but the suite lists no {slot}s", where=where)
-        try:
-            MissionHeader.model_validate({"mission": "check", "success": fill(task.expect, slots)})
-        except ValidationError as error:
-            _, message = describe_validation_error(error)
-            raise UserError(f"expect: {message}", where=source.where(("tasks", index, "expect"))) from None
+                raise UserError(
+                    f"the task uses {{{slot}}} but the suite lists no {slot}s", where=source.where(("tasks", index))
+                )
+        _check_expect(task.expect, ("tasks", index, "expect"), suite, source)
         if task.mission is not None and not (source.file.parent / task.mission).is_file():
             raise UserError(f"mission file not found: {task.mission}", where=source.where(("tasks", index, "mission")))
-    del world  # names in the expectations are checked when each episode's mission loads
+    for index, fault in enumerate(suite.faults.kinds):
+        if fault.new_command is not None:
+            _check_expect(fault.new_command.expect, ("faults", "kinds", index, "new_command", "expect"), suite, source)
+
+
+def _check_expect(expect: list[dict[str, Any]], path: tuple, suite: Suite, source: YamlSource) -> None:
+    """Success conditions checked the way a mission's are (kinds, fields, names), with the first names drawn."""
+    slots = {"object": (suite.objects or [""])[0], "surface": (suite.surfaces or [""])[0]}
+    probe = {"mission": "check", "world": suite.world, "robot": suite.robot, "tree": {"wait": {"seconds": 0}}}
+    try:
+        MissionLoader().load_data({**probe, "success": fill(expect, slots)}, name="<expect>")
+    except UserError as error:
+        raise UserError(f"expect: {error.message}", where=source.where(path), hint=error.hint) from None
 
 
 def fill(value: Any, slots: dict[str, str]) -> Any:

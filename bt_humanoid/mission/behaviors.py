@@ -14,7 +14,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError, create_model
 
-from bt_humanoid.errors import UserError, describe_validation_error
+from bt_humanoid.errors import UserError
 from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.strict_model import StrictModel
 from bt_humanoid.yaml_source import YamlSource, read_yaml
@@ -67,8 +67,7 @@ def load_behavior(file: Path) -> Behavior:
     try:
         header = BehaviorHeader.model_validate(source.data)
     except ValidationError as error:
-        location, message = describe_validation_error(error)
-        raise UserError(message, where=source.where(location)) from None
+        raise source.invalid(error) from None
     return Behavior(header.behavior, header.description, source, _args_model(header.behavior, header), header.example)
 
 

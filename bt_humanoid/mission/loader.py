@@ -15,7 +15,7 @@ from typing import Any, get_args
 
 from pydantic import BaseModel, ValidationError
 
-from bt_humanoid.errors import UserError, describe_validation_error, did_you_mean
+from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.mission.behaviors import BehaviorLibrary, substitute
 from bt_humanoid.mission.schema import (
     COMPOSITES,
@@ -39,12 +39,6 @@ from bt_humanoid.yaml_source import YamlPath, YamlSource, display_path, read_yam
 MAX_SUBTREE_DEPTH = 32
 
 
-def _first_error(error: ValidationError, source: YamlSource, base: YamlPath, prefix: str = "") -> UserError:
-    """The first pydantic error, positioned in the YAML and phrased for people."""
-    location, message = describe_validation_error(error)
-    return UserError(f"{prefix}{message}", where=source.where((*base, *location)))
-
-
 def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: YamlPath, prefix: str) -> BaseModel:
     """Validate a skill's parameters; ``"$key"`` blackboard references are checked when the leaf starts."""
     if raw is None:
@@ -61,7 +55,7 @@ def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: 
         if not remaining:
             return model.model_construct(**concrete)
         first_only = ValidationError.from_exception_data(error.title, [remaining[0]])  # type: ignore[list-item]
-        raise _first_error(first_only, source, path, prefix) from None
+        raise source.invalid(first_only, path, prefix) from None
 
 
 MAX_TREE_DEPTH = 64  # levels of nodes: far beyond any real mission, well inside Python's recursion limit
@@ -98,7 +92,7 @@ class MissionLoader:
         try:
             header = MissionHeader.model_validate(header_data)
         except ValidationError as error:
-            raise _first_error(error, source, ()) from None
+            raise source.invalid(error, ()) from None
         robot = _config_at(load_robot_config, header.robot, source, "robot")
         world = _config_at(load_world_config, header.world, source, "world")
         self.checks = CheckContext(robot, world, joint_ranges(robot))
@@ -138,7 +132,7 @@ class MissionLoader:
             try:
                 recovery = RecoverySettings.model_validate(raw["recovery"])
             except ValidationError as error:
-                raise _first_error(error, source, (*ypath, "recovery")) from None
+                raise source.invalid(error, (*ypath, "recovery")) from None
 
         def spec(**kw: Any) -> NodeSpec:
             return NodeSpec(kind=kind, path=node_path, where=source.where(bpath), name=name, recovery=recovery, **kw)
@@ -168,7 +162,7 @@ class MissionLoader:
         try:
             settings = model.model_validate(body)
         except ValidationError as error:
-            raise _first_error(error, source, bpath, prefix=f"{kind}: ") from None
+            raise source.invalid(error, bpath, prefix=f"{kind}: ") from None
         if kind == "subtree":
             return self._subtree_file(settings, source, bpath, node_path, stack, spec)
         children = []
@@ -200,7 +194,7 @@ class MissionLoader:
         try:
             args = args_model.model_validate(body or {})
         except ValidationError as error:
-            raise _first_error(error, source, bpath, prefix=f"{kind}: ") from None
+            raise source.invalid(error, bpath, prefix=f"{kind}: ") from None
         return self._expand(kind, behavior.source, args.model_dump(), source, bpath, node_path, stack, spec)
 
     def _subtree_file(self, settings, source, bpath, node_path, stack, spec) -> NodeSpec:
@@ -217,7 +211,7 @@ class MissionLoader:
         try:
             args = behavior.args_model.model_validate(settings.args)
         except ValidationError as error:
-            raise _first_error(error, source, (*bpath, "args"), prefix=f"subtree {behavior.name}: ") from None
+            raise source.invalid(error, (*bpath, "args"), prefix=f"subtree {behavior.name}: ") from None
         return self._expand(behavior.name, behavior.source, args.model_dump(), source, bpath, node_path, stack, spec)
 
     def _expand(self, name, behavior_source, args, call_source, bpath, node_path, stack, spec) -> NodeSpec:
@@ -255,7 +249,7 @@ class MissionLoader:
             try:
                 model.model_validate(condition)
             except ValidationError as error:
-                raise _first_error(error, source, ("success", i), prefix="success: ") from None
+                raise source.invalid(error, ("success", i), prefix="success: ") from None
 
     def _check_success(self, header: MissionHeader, source: YamlSource) -> None:
         world = self.checks.world

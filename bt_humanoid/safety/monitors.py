@@ -114,17 +114,16 @@ class BumperMonitor:
         return {int(self.model.geom_bodyid[pairs[r, 1 - s]]) for r, s in zip(rows, sides, strict=True)}
 
 
-def trunk_bodies(model: mujoco.MjModel, root: int, hand_bodies: list[int]) -> set[int]:
-    """The bodies of the robot under ``root`` that are not on an arm (the chain from a hand to the trunk)."""
+def trunk_bodies(model: mujoco.MjModel, robot: set[int], hand_bodies: list[int]) -> set[int]:
+    """The bodies of the ``robot`` that are not on an arm (the chain from a hand to the trunk)."""
     parent = model.body_parentid
 
     def ancestors(body: int) -> list[int]:
         chain = [body]
-        while chain[-1] not in (root, 0):
+        while chain[-1] != 0:
             chain.append(int(parent[chain[-1]]))
         return chain
 
-    robot = {b for b in range(model.nbody) if root in ancestors(b)}
     shared = set.intersection(*(set(ancestors(h)) for h in hand_bodies)) if hand_bodies else set()
     arm_roots = {next(b for b in reversed(ancestors(h)) if b not in shared) for h in hand_bodies}
     return {b for b in robot if not arm_roots & set(ancestors(b))}

@@ -22,13 +22,7 @@ class GroundTruth:
     def __init__(self, sim: Simulation) -> None:
         self.sim = sim
         self.model, self.data = sim.model, sim.data
-        robot_root = self.model.body("base").id
-        self.robot_bodies = {i for i in range(self.model.nbody) if self._root_of(i) == robot_root}
-
-    def _root_of(self, body: int) -> int:
-        while self.model.body_parentid[body] != 0:
-            body = self.model.body_parentid[body]
-        return body
+        self.robot_bodies = sim.robot_bodies
 
     def _object_body(self, name: str) -> int:
         return self.model.body(self.sim.world.objects[name].body).id
