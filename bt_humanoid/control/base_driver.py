@@ -10,6 +10,7 @@ falls far behind its plan is blocked: the goal fails and the base brakes.
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import numpy as np
 from ruckig import Trajectory
@@ -24,6 +25,19 @@ SETTLE_TIMEOUT = 2.0  # s after the plan ends before a goal that has not arrived
 
 BRAKE_ACCEL = 2.0  # × the base's acceleration limits when braking: an emergency stop, not a smooth one
 BRAKE_JERK = 8.0  # × its jerk limits when braking
+
+
+HELD_SHARE = 0.05  # a motion allowed less than this share of its speed is held (a protective stop)
+
+
+class SpeedLimiter(Protocol):
+    """Says how much of a planned base velocity may run now (speed and separation monitoring does)."""
+
+    hold_limit: float  # s a motion may be held before it fails
+
+    def share(self, velocity: np.ndarray) -> float: ...
+
+    def describe(self) -> str: ...
 
 
 def wrap_angle(angle: float) -> float:
@@ -47,6 +61,25 @@ class BaseDriver:
         self.target = self.reference.copy()
         self.braking = False
         self.tracking = False  # following references streamed by the whole-body controller
+        self.limiter: SpeedLimiter | None = None  # slows planned motions near people and things sensed
+        self.elapsed = 0.0  # s along the current plan: runs slower than the clock while the limiter slows it
+        self.last_step = io.time
+        self.planned_velocity = np.zeros(3)  # the plan's velocity at ``elapsed``, before the limiter's share
+        self.held_since: float | None = None  # when the limiter stopped the plan
+
+    def allowed_share(self, velocity: np.ndarray) -> float:
+        """The share (0 to 1) of ``velocity`` (vx, vy, yaw rate; world frame) the base may run at now."""
+        return self.limiter.share(velocity) if self.limiter is not None else 1.0
+
+    def held_too_long(self, share: float, now: float) -> str | None:
+        """Track a protective stop; the reason to give up once it has held a motion for the limiter's hold limit."""
+        if share >= HELD_SHARE or self.limiter is None:
+            self.held_since = None
+            return None
+        self.held_since = now if self.held_since is None else self.held_since
+        if now - self.held_since <= self.limiter.hold_limit:
+            return None
+        return f"held {now - self.held_since:.0f} s by a protective stop: {self.limiter.describe()}"
 
     def pose(self) -> np.ndarray:
         """Odometry: (x, y, yaw) from the base joint encoders."""
@@ -80,6 +113,8 @@ class BaseDriver:
         )
         self.trajectory = plan_trajectory(start, self.velocity, self.acceleration, target, plan_limits, phase_sync=True)
         self.start = self.io.time
+        self.elapsed, self.held_since, self.last_step = 0.0, None, self.io.time
+        self.planned_velocity = self.velocity.copy()
         self.target = target
         self.braking = self.tracking = False
         self.handle = MotionHandle(f"driving {distance:.2f} m", on_cancel=lambda _: self.brake())
@@ -124,11 +159,20 @@ class BaseDriver:
         if self.trajectory is None:
             self.io.command(self.actuators, np.zeros(3))
             return
-        elapsed = self.io.time - self.start
+        now = self.io.time
+        step, self.last_step = now - self.last_step, now
+        share = 1.0
+        if self.braking:
+            elapsed = now - self.start
+        else:  # plan time runs at the share the limiter allows: the path stays, the pace drops
+            share = self.allowed_share(self.planned_velocity)
+            self.elapsed += share * step
+            elapsed = self.elapsed
         position, velocity, acceleration = self.trajectory.at_time(min(elapsed, self.trajectory.duration))
         self.reference = np.array(position)
-        self.velocity = np.array(velocity)
-        self.acceleration = np.array(acceleration)
+        self.planned_velocity = np.array(velocity)
+        self.velocity = share * self.planned_velocity  # what is commanded: braking starts from it
+        self.acceleration = share * np.array(acceleration)
         if self.braking:
             # velocity-only braking: no position correction, just ramp the command to zero
             self.io.command(self.actuators, self.velocity)
@@ -141,11 +185,17 @@ class BaseDriver:
         error = self.reference - pose
         error[2] = wrap_angle(error[2])
         self.io.command(self.actuators, self.velocity + POSITION_GAIN * error)
-        self._check_progress(pose, elapsed)
+        self._check_progress(pose, elapsed, share)
 
-    def _check_progress(self, pose: np.ndarray, elapsed: float) -> None:
+    def _check_progress(self, pose: np.ndarray, elapsed: float, share: float) -> None:
         handle = self.handle
         if handle is None:
+            return
+        held = self.held_too_long(share, self.io.time) if elapsed < self.trajectory.duration else None
+        if held is not None:
+            handle.fail(held)
+            self.handle = None
+            self.brake()
             return
         tracking = float(np.hypot(*(self.reference[:2] - pose[:2])))
         remaining = float(np.hypot(*(self.target[:2] - pose[:2])))

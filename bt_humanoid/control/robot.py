@@ -11,7 +11,7 @@ from typing import Protocol
 
 import numpy as np
 
-from bt_humanoid.control.base_driver import BaseDriver
+from bt_humanoid.control.base_driver import BaseDriver, SpeedLimiter
 from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.whole_body import WholeBodyController
@@ -30,6 +30,12 @@ class Planner(Protocol):
     def halt(self) -> None: ...
 
 
+class Separation(SpeedLimiter, Protocol):
+    """Speed and separation monitoring: updated every control step, before anything moves."""
+
+    def update(self, base_xy: np.ndarray) -> None: ...
+
+
 class RobotController:
     """Base driver, joint references and grippers of one robot."""
 
@@ -44,6 +50,7 @@ class RobotController:
         ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
         self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
         self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
+        self.separation: Separation | None = None  # set with monitor_separation()
         self.control_period = 0.01  # s between step() calls; the executor sets it
 
     def set_control_period(self, period: float) -> None:
@@ -51,7 +58,14 @@ class RobotController:
         self.control_period = period
         self.whole_body.dt = period
 
+    def monitor_separation(self, separation: Separation) -> None:
+        """Slow the base near people and things it senses (``separation.share`` limits every base motion)."""
+        self.separation = separation
+        self.base.limiter = separation
+
     def step(self) -> None:
+        if self.separation is not None:
+            self.separation.update(self.base.pose()[:2])
         for planner in self.planners:
             planner.step()
         self.whole_body.step()  # streams references first, the controllers below then track them

@@ -21,6 +21,7 @@ from bt_humanoid.mission.success import ConditionResult, check_condition
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import Perceiver
+from bt_humanoid.perception.safety_scanner import SafetyScanner
 from bt_humanoid.safety.monitors import (
     BumperMonitor,
     JointLimitMonitor,
@@ -29,6 +30,7 @@ from bt_humanoid.safety.monitors import (
     TimeBudgetMonitor,
     trunk_bodies,
 )
+from bt_humanoid.safety.separation import SpeedAndSeparation
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.skills.base import Skill
@@ -116,6 +118,7 @@ class MissionRun:
             self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, "base")
             self.robot.planners.append(self.perceiver)
             self.context.perceiver = self.perceiver
+        self.separation = self._separation()
         self._prepare(self.spec)
 
     def _prepare(self, spec: MissionSpec) -> None:
@@ -143,6 +146,34 @@ class MissionRun:
         observers = self.executor.observers if hasattr(self, "executor") else []
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
         self.executor.observers.extend(observers)
+
+    def _separation(self) -> SpeedAndSeparation | None:
+        """Speed and separation monitoring from the base scanner, when the robot has one."""
+        config = self.context.robot_config
+        if config.scanner is None:
+            return None
+        model = self.sim.model
+        base_body = int(model.jnt_bodyid[model.joint(config.base.joints["yaw"]).id])
+        whole_body = self.robot.whole_body
+
+        def hands() -> list[np.ndarray]:
+            return [whole_body.frame_pose(whole_body.hand_frame(side)).translation for side in config.grippers]
+
+        def zone(name: str, distance: float) -> None:
+            self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))
+
+        separation = SpeedAndSeparation(
+            SafetyScanner(model, self.sim.data, base_body, config.scanner),
+            config.safety,
+            config.base.footprint_radius,
+            config.base.limits.max_speed,
+            furniture=self.navigator.is_furniture,
+            people=lambda: list(self.context.world_model.people.values()),
+            hands=hands,
+            on_zone=zone,
+        )
+        self.robot.monitor_separation(separation)
+        return separation
 
     def _trunk(self) -> set[int]:
         """The robot's bodies that are not on an arm: what the bumper monitor watches."""

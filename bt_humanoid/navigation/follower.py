@@ -71,6 +71,7 @@ class RouteFollower:
         self.started_settling: float | None = None
         self.stop_at = None
         self.speed_limit = math.inf
+        self.base.held_since = None
         self.handle = MotionHandle(f"following a {route.length:.1f} m route", on_cancel=lambda _: self.stop())
         return self.handle
 
@@ -90,7 +91,19 @@ class RouteFollower:
         inp = self._input
         s = float(inp.current_position[0])
         index = int(np.searchsorted(route.arc_length, s))
-        inp.max_velocity = [self._speed_cap(route, s, float(inp.current_velocity[0])), self.config.limits.max_yaw_rate]
+        limits = self.config.limits
+        # speed and separation: the share of full speed along the route (and of the turn) allowed now
+        share = self.base.allowed_share(
+            np.array([*(self.max_speed * self._point(route, s)[1]), inp.current_velocity[1]])
+        )
+        held = self.base.held_too_long(share, self.base.io.time)
+        if held is not None:
+            handle.fail(held)
+            self.handle = None
+            self.stop()
+            return
+        speed_cap = min(self._speed_cap(route, s, float(inp.current_velocity[0])), share * self.max_speed)
+        inp.max_velocity = [max(speed_cap, 1e-3), max(share * limits.max_yaw_rate, 1e-3)]
         yaw = self._heading_target(route, s, index)
         end = route.length if self.stop_at is None else min(route.length, max(s, self.stop_at - STOP_SHORT))
         inp.target_position = [end, float(inp.current_position[1]) + wrap_angle(yaw - inp.current_position[1])]

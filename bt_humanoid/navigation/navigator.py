@@ -102,6 +102,14 @@ class Navigator:
             self.handle.fail("halted: braking")
             self.handle = None
 
+    def is_furniture(self, points: np.ndarray) -> np.ndarray:
+        """Per floor point (x, y): on or next to the map's furniture and walls (outside the map counts too)."""
+        rows, cols = self.grid.cell(points)
+        inside = self.grid.inside(rows, cols)
+        result = np.ones(len(points), dtype=bool)
+        result[inside] = self._near_static[rows[inside], cols[inside]]
+        return result
+
     def clear_map(self) -> None:
         """Forget every obstacle the camera added; the next scans add back what is still there."""
         self.grid.clear_observed()
@@ -151,24 +159,42 @@ class Navigator:
         try:
             route = self._plan()
         except PlanError as error:
+            if self._blocked_only_by_what_was_seen():  # a person on the way or at the goal may walk on: wait
+                self._wait(self.robot.base.io.time)
+                return
             self._finish_goal(str(error), brake=True)
             return
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
 
+    def _blocked_only_by_what_was_seen(self) -> bool:
+        """Whether the map alone, without what the camera added, has a route to the goal."""
+        if not np.any(self.grid.observed):
+            return False
+        try:
+            plan_route(self.grid.without_observed(), self.robot.base.pose(), self.goal, self.clearance)
+        except PlanError:
+            return False
+        return True
+
+    def _wait(self, now: float) -> None:
+        self.waiting_since = now
+        self.motion = None
+        self.follower.stop()
+
     def _replan(self, now: float) -> None:
         """The way ahead got blocked: take a new route, or stop and wait for one (a person may walk on)."""
-        self.replans += 1
-        try:
+        if self.waiting_since is None:  # a new route for a blocked one; tries while waiting are not counted
+            self.replans += 1
             if self.replans > MAX_REPLANS:
-                raise PlanError(f"the way stayed blocked after {MAX_REPLANS} replans")
+                self._finish_goal(f"the way kept getting blocked: {MAX_REPLANS} new routes taken", brake=True)
+                return
+        try:
             route = self._plan()
         except PlanError as error:
             if self.waiting_since is None:
-                self.waiting_since = now
-                self.motion = None
-                self.follower.stop()
-            elif now - self.waiting_since > WAIT_LIMIT or self.replans > MAX_REPLANS:
+                self._wait(now)
+            elif now - self.waiting_since > WAIT_LIMIT:
                 self._finish_goal(f"waited {WAIT_LIMIT:.0f} s for the way to clear: {error}", brake=True)
             return
         self.waiting_since = None

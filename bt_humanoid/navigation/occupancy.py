@@ -10,6 +10,8 @@ changes; planners and followers ask it whether the robot's disc fits.
 
 from __future__ import annotations
 
+import copy
+
 import cv2
 import numpy as np
 
@@ -71,6 +73,13 @@ class OccupancyGrid:
         if np.any(self.observed):
             self.observed[:] = False
             self._clearance = None
+
+    def without_observed(self) -> OccupancyGrid:
+        """A copy with only the static map: what the floor would be if everything the camera saw moved away."""
+        grid = copy.copy(self)
+        grid.observed = np.zeros_like(self.observed)
+        grid._clearance = None
+        return grid
 
     # ------------------------------------------------------------------ clearance
 

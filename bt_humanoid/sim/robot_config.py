@@ -53,6 +53,15 @@ class CameraConfig(StrictModel):
     rate_hz: float = 10.0
 
 
+class ScannerConfig(StrictModel):
+    """A planar range scanner on the base (a safety laser scanner), for speed and separation monitoring."""
+
+    height: float = Field(0.25, gt=0, description="m above the floor where the rays sweep")
+    rays: int = Field(180, ge=8, le=2000, description="rays over the full circle")
+    range: float = Field(4.0, gt=0, description="m beyond which nothing is seen")
+    rate_hz: float = Field(50.0, gt=0, description="scans per second")
+
+
 class MotionLimits(StrictModel):
     velocity: float
     acceleration: float
@@ -63,6 +72,9 @@ class SafetyDefaults(StrictModel):
     max_base_speed: float = 0.8
     joint_limit_margin: float = 0.01
     time_budget: float = 600.0
+    slow_distance: float = 1.0  # m between the robot and the nearest sensed thing below which it slows
+    stop_distance: float = 0.2  # m below which nothing moves towards it (a protective stop)
+    hold_limit: float = 10.0  # s a protective stop may hold a motion before the motion fails
 
 
 class RecoveryDefaults(StrictModel):
@@ -79,6 +91,7 @@ class RobotConfig(StrictModel):
     grippers: dict[str, GripperConfig]
     frames: dict[str, tuple[str, str]]
     cameras: dict[str, CameraConfig] = Field(default_factory=dict)
+    scanner: ScannerConfig | None = None
     joint_limits: dict[str, MotionLimits]
     postures: dict[str, dict[str, float]]
     safety: SafetyDefaults = SafetyDefaults()

@@ -1,0 +1,63 @@
+"""A planar safety laser scanner low on the base: ranges all round the robot at one height.
+
+Mobile robots that work near people carry one (the head camera looks where
+the robot goes; the scanner also sees who comes from the side or behind).
+Each ray is cast through the scene with ``mj_multiRay`` from the scanner's
+current pose, as a real scanner measures time of flight; the robot's own
+base is skipped, as a scanner's housing is.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from bt_humanoid.sim.robot_config import ScannerConfig
+
+
+class SafetyScanner:
+    """``scan()`` returns the floor points (x, y) where the rays hit something, at the scanner's rate."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, base_body: int, config: ScannerConfig) -> None:
+        self.model, self.data = model, data
+        self.base_body = base_body
+        self.config = config
+        angles = np.linspace(0.0, 2 * math.pi, config.rays, endpoint=False)
+        self._angles = angles
+        self._geom_ids = np.zeros(config.rays, dtype=np.int32)
+        self._distances = np.zeros(config.rays)
+        self.period = 1.0 / config.rate_hz
+        self.last_scan = -math.inf
+        self.points = np.zeros((0, 2))  # the latest scan's hits (world x, y)
+
+    def scan(self) -> np.ndarray:
+        """Hits of a fresh scan when one is due, else the latest ones (world x, y)."""
+        now = self.data.time
+        if now - self.last_scan < self.period - 1e-9:
+            return self.points
+        self.last_scan = now
+        position = self.data.xpos[self.base_body]
+        yaw = math.atan2(self.data.xmat[self.base_body][3], self.data.xmat[self.base_body][0])
+        directions = np.zeros((self.config.rays, 3))
+        directions[:, 0] = np.cos(self._angles + yaw)
+        directions[:, 1] = np.sin(self._angles + yaw)
+        origin = np.array([position[0], position[1], self.config.height])
+        mujoco.mj_multiRay(
+            self.model,
+            self.data,
+            origin,
+            directions.ravel(),
+            None,
+            1,
+            self.base_body,
+            self._geom_ids,
+            self._distances,
+            None,
+            self.config.rays,
+            self.config.range,
+        )
+        hit = self._geom_ids >= 0
+        self.points = origin[:2] + directions[hit, :2] * self._distances[hit, None]
+        return self.points
