@@ -2,11 +2,12 @@
 
 The base scanner's hits that are not the map's furniture (a person, a parcel,
 a box that was moved) each set how fast the robot may close in on them: full
-speed beyond ``slow_distance`` from the robot's outline, falling linearly to
+speed beyond ``slow_distance`` from the robot, falling linearly to
 nothing at ``stop_distance`` (a protective stop, in the sense of ISO/TS 15066).
 Moving away or sideways is always allowed, so a robot that someone stands
-close to can still make way. Turning counts as closing in when an arm reaches
-out past the base: the hand sweeps round. Nothing latches: the motion goes
+close to can still make way. The robot's parts are the base and the hands:
+turning moves a hand that reaches out, and that counts as closing in too.
+Nothing latches: the motion goes
 on when the way clears, and a motion held too long fails (``hold_limit``).
 """
 
@@ -21,6 +22,7 @@ from bt_humanoid.sim.robot_config import SafetyDefaults
 
 PERSON_RADIUS = 0.4  # m around a known person's position where hits are them, though the map has them as fixed
 HAND_RADIUS = 0.06  # m a hand (and what it holds) reaches past its grip point
+LOOK_AHEAD = 0.01  # s over which a part's closing speed is measured
 HYSTERESIS = 0.05  # m a zone is left by, so a person at its edge does not flood the event log
 
 
@@ -45,51 +47,63 @@ class SpeedAndSeparation:
         self.furniture, self.people, self.hands = furniture, people, hands
         self.on_zone = on_zone
         self.zone = "clear"
-        self.distance = np.inf  # m from the robot's outline to the nearest sensed thing
-        self.outline = footprint  # m from the base centre that the robot reaches now (arms included)
-        self._gaps = np.zeros(0)  # m per sensed thing within the slow zone, from the outline
-        self._directions = np.zeros((0, 2))  # unit vectors from the base centre to them
+        self.distance = np.inf  # m from the nearest part of the robot to the nearest sensed thing
+        self._points = np.zeros((0, 2))  # sensed things within the slow zone of a part
+        self._parts = np.zeros((0, 2))  # the robot's parts as discs on the floor: the base, then each hand
+        self._arms = np.zeros((0, 2))  # each part's centre from the base centre: it swings when the base turns
+        self._radii = np.zeros(0)
+        self._gaps = np.zeros(0)  # per part: m to the nearest sensed thing
 
     def update(self, base_xy: np.ndarray) -> None:
-        """Scan, and find what is near the robot's outline."""
+        """Scan, and find what is near the base or a hand."""
         points = self.scanner.scan()
-        reach = [float(np.hypot(*(hand[:2] - base_xy))) + HAND_RADIUS for hand in self.hands()]
-        self.outline = max([self.footprint, *reach])
         if len(points):
             near_person = np.zeros(len(points), dtype=bool)
             for person in self.people():
                 near_person |= np.hypot(*(points - person[:2]).T) < PERSON_RADIUS
             points = points[near_person | ~self.furniture(points)]
-        offsets = points - base_xy
-        ranges = np.hypot(*offsets.T) if len(points) else np.zeros(0)
-        gaps = ranges - self.outline
-        close = gaps < self.slow
-        self._gaps = gaps[close]
-        self._directions = offsets[close] / np.maximum(ranges[close, None], 1e-6)
-        self.distance = float(gaps.min()) if len(gaps) else np.inf
+        self._arms = np.array([np.zeros(2), *(hand[:2] - base_xy for hand in self.hands())])
+        self._parts = base_xy + self._arms
+        self._radii = np.array([self.footprint] + [HAND_RADIUS] * (len(self._arms) - 1))
+        gaps = self._gaps_of(self._parts, points)  # (points, parts)
+        self._points = points[np.any(gaps < self.slow, axis=1)]
+        self._gaps = gaps.min(axis=0) if len(points) else np.full(len(self._parts), np.inf)
+        self.distance = float(self._gaps.min())
         self._update_zone()
 
     def share(self, velocity: np.ndarray) -> float:
-        """The share (0 to 1) of a base velocity (vx, vy, yaw rate; world frame) that keeps the closing speeds."""
-        if not len(self._gaps):
+        """The share (0 to 1) of a base velocity (vx, vy, yaw rate; world frame) that keeps the closing speeds.
+
+        A part's closing speed is how fast its gap to the nearest sensed thing shrinks, over a short look ahead:
+        sliding past the side of a person does not count, heading at them does.
+        """
+        if not len(self._points):
             return 1.0
-        allowed = self.max_speed * np.clip((self._gaps - self.stop) / (self.slow - self.stop), 0.0, 1.0)
-        sweep = abs(float(velocity[2])) * max(self.outline - self.footprint, 0.0)
-        closing = np.maximum(self._directions @ np.asarray(velocity[:2], dtype=float), 0.0) + sweep
-        limited = closing > allowed + 1e-9
+        vx, vy, yaw_rate = (float(v) for v in velocity)
+        # each part moves with the base and, when the base turns, at right angles to its arm
+        moving = np.array([vx, vy]) + yaw_rate * np.stack([-self._arms[:, 1], self._arms[:, 0]], axis=1)
+        ahead = self._gaps_of(self._parts + moving * LOOK_AHEAD, self._points).min(axis=0)
+        now = self._gaps_of(self._parts, self._points).min(axis=0)
+        closing = np.maximum(now - ahead, 0.0) / LOOK_AHEAD
+        allowed = self.max_speed * np.clip((now - self.stop) / (self.slow - self.stop), 0.0, 1.0)
+        limited = closing > allowed + 1e-6
         if not np.any(limited):
             return 1.0
         return float(np.min(allowed[limited] / closing[limited]))
+
+    def _gaps_of(self, parts: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """(points, parts): metres between each sensed point and each part's edge."""
+        offsets = points[:, None, :] - parts[None, :, :]
+        return np.hypot(offsets[..., 0], offsets[..., 1]) - self._radii[None, :]
 
     def describe(self) -> str:
         return f"something {max(self.distance, 0.0):.2f} m from the robot"
 
     def _update_zone(self) -> None:
         d, zone = self.distance, self.zone
-        margin = {"clear": 0.0, "slow": HYSTERESIS, "stop": HYSTERESIS}[zone]
-        if d < self.stop + (margin if zone == "stop" else 0.0):
+        if d < self.stop + (HYSTERESIS if zone == "stop" else 0.0):
             new = "stop"
-        elif d < self.slow + (margin if zone != "clear" else 0.0):
+        elif d < self.slow + (HYSTERESIS if zone != "clear" else 0.0):
             new = "slow"
         else:
             new = "clear"
