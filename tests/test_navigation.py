@@ -9,6 +9,8 @@ from py_trees.common import Status
 
 from bt_humanoid.cli import run_main
 from bt_humanoid.engine.composites import RoundRobin
+from bt_humanoid.navigation.navigator import OBSERVED_MEMORY
+from bt_humanoid.navigation.occupancy import OccupancyGrid
 from bt_humanoid.navigation.planner import Clearance, PlanError, plan_route
 from bt_humanoid.testing.scenario import Scenario, build_run
 
@@ -100,19 +102,32 @@ def test_a_parcel_dropped_on_the_route_is_seen_and_driven_around():
         run.sim.data.qvel[run.sim.model.joint("parcel").dofadr[0] : run.sim.model.joint("parcel").dofadr[0] + 6] = 0
         dropped.append(ahead)
 
-    run.executor.observers.append(drop_the_parcel_ahead)
+    on_the_map: list[int] = []  # cells the camera put on the parcel, while it was in view and remembered
+
+    def mapped_parcel_cells() -> None:
+        if dropped:
+            seen = navigator.grid.centre(*np.nonzero(navigator.grid.observed))
+            on_the_map.append(int(np.all(np.abs(seen - dropped[0]) <= 0.2, axis=1).sum()))
+
+    run.executor.observers.extend([drop_the_parcel_ahead, mapped_parcel_cells])
     contacts = _watch_contacts(run)
     scenario = Scenario(run, run.execute())
     assert dropped, "the fault was never injected"
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
     assert len(navigator.planning_times) >= 2, "it replanned"
-    grid = navigator.grid
-    seen = grid.centre(*np.nonzero(grid.observed))
-    on_parcel = np.all(np.abs(seen - dropped[0]) <= 0.2, axis=1)
-    assert on_parcel.sum() >= 3, "the camera put the parcel on the map"
+    assert max(on_the_map) >= 3, "the camera put the parcel on the map"
     assert not any("parcel" in other for _, other in contacts)
     x, y, _ = scenario.truth.robot_pose()
     assert math.hypot(x - 7.0, y - 2.4) <= 0.05
+
+
+def test_what_the_camera_saw_is_forgotten_once_out_of_sight_for_a_while():
+    grid = OccupancyGrid(np.array([[0.0, 0.0], [2.0, 2.0]]), 0.1)
+    grid.mark(np.array([[0.5, 0.5]]), now=1.0)
+    grid.mark(np.array([[1.5, 1.5]]), now=4.0)
+    grid.forget_older_than(3.0)
+    rows, cols = np.nonzero(grid.observed)
+    assert grid.centre(rows, cols).tolist() == [[1.55, 1.55]]
 
 
 def test_a_goal_in_the_table_ends_after_bounded_recovery_naming_the_goal(tmp_path, capsys):
@@ -158,6 +173,21 @@ def test_a_world_can_extend_another_and_add_a_walking_person():
     walked = float(np.hypot(*(run.sim.walkers[0].position() - start)))
     assert 0.6 < walked <= 1.05  # 2 s at 0.5 m/s, driven by its actuators
     assert not run.navigator.grid.static[run.navigator.grid.cell(start[None, :])].any(), "people are not on the map"
+
+
+def test_a_walker_waits_for_a_robot_in_the_way_then_turns_back():
+    """The robot stands on the person's loop: they stop short of it, and after a while walk the loop the other way."""
+    mission = {"mission": "in the way", "world": "apartment_busy", "tree": {"wait": {"seconds": 12}}}
+    run = build_run(mission, robot_start=(4.7, -0.6, 90.0))  # on the loop's west leg, which they walk north
+    walker = run.sim.walkers[0]
+    contacts = _watch_contacts(run)
+    trail: list[np.ndarray] = []
+    run.executor.observers.append(lambda: trail.append(walker.position().copy()))
+    run.execute()
+    apart = np.hypot(*(np.array(trail) - [4.7, -0.6]).T)
+    assert apart.min() > 0.32 + 0.2 + 0.1, "stopped short of the robot's base"
+    assert walker.direction == -1 and trail[-1][0] > 5.3, "turned back, and went round the other way"
+    assert not [c for c in contacts if "walker" in c[1]]
 
 
 def test_crossing_the_walking_persons_loop_never_touches_them():
@@ -223,8 +253,24 @@ def test_an_obstacle_the_camera_finds_gone_is_cleared_from_the_map():
     # a box the robot once saw on the way, no longer there: the cells are in the map, the floor is free
     xs, ys = np.meshgrid(np.arange(1.8, 2.2, 0.05), np.arange(1.0, 1.4, 0.05))
     phantom = np.stack([xs.ravel(), ys.ravel()], axis=1)
-    grid.mark(phantom)
+    grid.mark(phantom, now=0.0)
+    cleared: list[float] = []
+    run.executor.observers.append(
+        lambda: cleared or grid.observed[grid.cell(phantom)].mean() >= 0.2 or cleared.append(run.sim.time)
+    )
     scenario = Scenario(run, run.execute())
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
-    still = grid.observed[grid.cell(phantom)]
-    assert still.mean() < 0.2, f"{still.sum()} of {still.size} cells still marked"
+    assert cleared and cleared[0] < OBSERVED_MEMORY, "seen free, before it would have been forgotten"
+
+
+def test_a_goal_blocked_only_by_what_the_camera_saw_is_waited_for():
+    """Someone stands where the robot is going: it waits for the way to clear instead of failing at once."""
+    run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
+    kitchen = np.array(run.context.world.places["kitchen"].pose[:2])
+    xs, ys = np.meshgrid(np.arange(-0.2, 0.2, 0.05), np.arange(-0.2, 0.2, 0.05))
+    run.navigator.grid.mark(kitchen + np.stack([xs.ravel(), ys.ravel()], axis=1), now=0.0)
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    feedback = [e["feedback"] for e in scenario.result.events.events if e["event"] == "status"]
+    assert not any("inside an obstacle" in f for f in feedback)
+    assert run.navigator.planning_times[0] == 0.0, "the first plan found the goal blocked (and the robot waited)"

@@ -33,6 +33,7 @@ FREE_BELOW = 0.1  # m: a ray passing a cell lower than this shows nothing taller
 OWN_MARGIN = 0.03  # m beyond the footprint where depth points are the robot's own bumper
 HELD_RADIUS = 0.15  # m around a hand where points below it are what it holds
 SEEN_DEPTH = 0.3  # m an obstacle is assumed to extend behind the face the camera sees (a person, a parcel)
+OBSERVED_MEMORY = 6.0  # s an obstacle the camera saw is kept after it was last seen (out of view: it may move)
 OBSERVED_PADDING = 0.2  # m more room given to what the camera saw than to the furniture: it may move
 GAZE_AHEAD = 1.5  # m along the route where the head looks
 CAUTION_DISTANCE = 1.0  # m between the footprint and something the camera saw, below which the base slows
@@ -57,6 +58,7 @@ class Navigator:
         self.remap()
         camera = next(iter(config.cameras), None)
         self.camera = DepthCamera(sim.model, sim.data, camera, "base") if camera else None
+        self.camera_frame = config.frames[camera][1] if camera in config.frames else None
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
         self.last_scan = -math.inf
         self.follower = RouteFollower(robot.base, config.base, robot.control_period)
@@ -70,6 +72,7 @@ class Navigator:
         self.route: Route | None = None
         self.motion: MotionHandle | None = None  # the follower's handle for the current route
         self.waiting_since: float | None = None  # stopped because no route is free now
+        self.resume_tilt: float | None = None  # the head's tilt before a wait (it looks down at the goal meanwhile)
 
     def remap(self) -> None:
         """Build the floor plan from the furniture where it stands now (at start, or after it was rearranged)."""
@@ -129,7 +132,10 @@ class Navigator:
                 blocked_at = self._blocked_at()  # on the new route, if there is one
             self.follower.stop_at = blocked_at
             self.follower.speed_limit = self._speed_near_obstacles()
-            self._look_along_route()
+            if self.waiting_since is not None and self.goal is not None:
+                self._look_towards(self.goal[:2], at_floor=True)  # to see the way there clear when they walk on
+            else:
+                self._look_along_route()
         if self.handle is None:
             return
         if self.waiting_since is not None:
@@ -181,6 +187,15 @@ class Navigator:
         self.waiting_since = now
         self.motion = None
         self.follower.stop()
+        tilt = self.robot.config.head_tilt
+        self.resume_tilt = self.robot.joint_positions()[tilt] if tilt is not None else None
+
+    def _stop_waiting(self) -> None:
+        """Back on the way: the head looks ahead again as it did before the wait."""
+        self.waiting_since = None
+        tilt = self.robot.config.head_tilt
+        if tilt is not None and self.resume_tilt is not None:
+            self.robot.joints.move({tilt: self.resume_tilt})
 
     def _replan(self, now: float) -> None:
         """The way ahead got blocked: take a new route, or stop and wait for one (a person may walk on)."""
@@ -197,7 +212,8 @@ class Navigator:
             elif now - self.waiting_since > WAIT_LIMIT:
                 self._finish_goal(f"waited {WAIT_LIMIT:.0f} s for the way to clear: {error}", brake=True)
             return
-        self.waiting_since = None
+        if self.waiting_since is not None:
+            self._stop_waiting()
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
 
@@ -215,10 +231,20 @@ class Navigator:
         if route is None or pan is None or self.follower.route is None:
             return
         s = self.follower.progress
-        point = route.points[min(np.searchsorted(route.arc_length, s + GAZE_AHEAD), len(route.points) - 1)]
+        self._look_towards(route.points[min(np.searchsorted(route.arc_length, s + GAZE_AHEAD), len(route.points) - 1)])
+
+    def _look_towards(self, point: np.ndarray, at_floor: bool = False) -> None:
+        """Turn the head towards a floor point; ``at_floor`` tips it down to see the floor there too."""
+        if self.head_pan is None:
+            return
         x, y, yaw = self.robot.base.pose()
         bearing = math.remainder(math.atan2(point[1] - y, point[0] - x) - yaw, 2 * math.pi)
-        self.robot.joints.move({pan: float(np.clip(bearing, -MAX_GAZE_PAN, MAX_GAZE_PAN))})
+        targets = {self.head_pan: float(np.clip(bearing, -MAX_GAZE_PAN, MAX_GAZE_PAN))}
+        tilt = self.robot.config.head_tilt
+        if at_floor and tilt is not None and self.camera_frame is not None:
+            camera = self.robot.whole_body.frame_pose(self.camera_frame).translation
+            targets[tilt] = math.atan2(camera[2], float(np.hypot(*(point[:2] - camera[:2]))))
+        self.robot.joints.move(targets)
 
     def _blocked_at(self) -> float | None:
         """Arc length of the first point ahead on the route where the base would touch something, if any."""
@@ -271,7 +297,9 @@ class Navigator:
         away_from_camera /= np.maximum(np.hypot(*away_from_camera.T), 1e-6)[:, None]
         depths = np.arange(0.0, SEEN_DEPTH + 1e-9, self.grid.resolution)
         behind = solid[:, None, :] + depths[None, :, None] * away_from_camera[:, None, :]
-        self.grid.mark(behind.reshape(-1, 2))
+        now = self.robot.base.io.time
+        self.grid.mark(behind.reshape(-1, 2), now)
+        self.grid.forget_older_than(now - OBSERVED_MEMORY)
         rows, cols = self._cells_seen_free(scan)
         self.grid.clear(rows, cols)
 

@@ -26,6 +26,7 @@ class OccupancyGrid:
         self.shape = (int(size[1]), int(size[0]))  # rows (y), cols (x)
         self.static = np.zeros(self.shape, dtype=bool)
         self.observed = np.zeros(self.shape, dtype=bool)
+        self.seen_at = np.full(self.shape, -np.inf)  # s: when each observed cell was last seen occupied
         self.observed_padding = observed_padding  # m added around what the camera saw
         self._clearance: np.ndarray | None = None
         self._observed_distance = np.full(self.shape, np.inf)
@@ -50,11 +51,12 @@ class OccupancyGrid:
     def occupied(self) -> np.ndarray:
         return self.static | self.observed
 
-    def mark(self, xy: np.ndarray) -> None:
-        """Mark the cells under world points as seen occupied."""
+    def mark(self, xy: np.ndarray, now: float = 0.0) -> None:
+        """Mark the cells under world points as seen occupied (at time ``now``)."""
         rows, cols = self.cell(xy)
         keep = self.inside(rows, cols)
         rows, cols = rows[keep], cols[keep]
+        self.seen_at[rows, cols] = now
         new = ~self.observed[rows, cols] & ~self.static[rows, cols]
         if np.any(new):  # the clearance field is recomputed only when something changed
             self.observed[rows[new], cols[new]] = True
@@ -66,6 +68,13 @@ class OccupancyGrid:
         rows, cols = rows[keep], cols[keep]
         if np.any(self.observed[rows, cols]):
             self.observed[rows, cols] = False
+            self._clearance = None
+
+    def forget_older_than(self, time: float) -> None:
+        """Forget observed cells last seen before ``time``: a person seen there has likely walked on."""
+        stale = self.observed & (self.seen_at < time)
+        if np.any(stale):
+            self.observed[stale] = False
             self._clearance = None
 
     def clear_observed(self) -> None:

@@ -115,6 +115,11 @@ class RobotConfig(StrictModel):
         return next((j for j in self.groups.get("head", []) if "pan" in j), None)
 
     @property
+    def head_tilt(self) -> str | None:
+        """The head joint that tips the camera up and down (positive looks down), if any."""
+        return next((j for j in self.groups.get("head", []) if "tilt" in j), None)
+
+    @property
     def actuated_joints(self) -> list[str]:
         """Every position-controlled joint: groups first, then gripper fingers."""
         joints = [j for group in self.groups.values() for j in group]
