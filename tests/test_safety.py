@@ -88,3 +88,26 @@ def test_the_arms_may_touch_what_they_work_on():
     result = run.execute()
     assert result.success, result.cause or result.safety
     assert result.safety is None
+
+
+def test_workspace_monitor_fires_off_the_map_and_for_a_hand_near_the_floor():
+    import numpy as np
+
+    from bt_humanoid.safety.monitors import WorkspaceMonitor
+
+    run = build_run({"mission": "idle", "tree": {"wait": {"seconds": 0}}})
+    bounds = np.array(run.context.world.bounds)
+    assert WorkspaceMonitor(run.robot, bounds, 0.1).check(0.0) is None
+    elsewhere = bounds + [[5.0, 5.0], [5.0, 5.0]]  # a map the robot's start is not on
+    assert "left the map" in WorkspaceMonitor(run.robot, elsewhere, 0.1).check(0.0)
+    message = WorkspaceMonitor(run.robot, bounds, 0.6).check(0.0)  # the hands hang about 0.48 m up
+    assert message.startswith("the left hand is 48 cm above the floor")
+
+
+def test_a_relative_move_that_would_leave_the_map_is_refused_before_moving():
+    run = build_run({"mission": "away", "tree": {"move_base": {"x": 30.0, "relative": True}}})
+    start = run.robot.base.pose()
+    result = run.execute()
+    assert result.tree_status == "FAILURE"
+    assert "move_base: the goal (30.0, 0.0) is outside the map" in result.cause
+    assert abs(run.robot.base.pose() - start).max() < 1e-3

@@ -274,3 +274,17 @@ def test_malformed_world_file_is_reported_at_its_line(tmp_path):
     with pytest.raises(UserError) as raised:
         read_config("world", tmp_path / "worlds", "flat", "world.yaml", WorldConfig)
     assert "world.yaml:4" in str(raised.value) and "places.a.pose" in str(raised.value)
+
+
+def test_a_move_to_a_spot_off_the_map_is_refused(tmp_path, capsys):
+    path = write(
+        tmp_path,
+        "far.yaml",
+        """
+        mission: far away
+        tree:
+          move_base: {x: 50, y: 0}
+        """,
+    )
+    code, err = validate(capsys, path)
+    assert code == 2 and "far.yaml:3" in err and "(50.0, 0.0) is outside the map: x -2 to 9" in err

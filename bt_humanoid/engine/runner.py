@@ -28,6 +28,7 @@ from bt_humanoid.safety.monitors import (
     SafetySupervisor,
     StopRequestMonitor,
     TimeBudgetMonitor,
+    WorkspaceMonitor,
     trunk_bodies,
 )
 from bt_humanoid.safety.separation import SpeedAndSeparation
@@ -136,6 +137,7 @@ class MissionRun:
             JointLimitMonitor(self.robot, margin),
             TimeBudgetMonitor(self.time_budget, self.sim.time),
             BumperMonitor(self.sim.model, self.sim.data, self._trunk(), self.sim.robot_bodies),
+            WorkspaceMonitor(self.robot, np.array(spec.known.world.bounds), defaults.min_hand_height),
         ]
         self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time)
 

@@ -129,6 +129,33 @@ def trunk_bodies(model: mujoco.MjModel, robot: set[int], hand_bodies: list[int])
     return {b for b in robot if not arm_roots & set(ancestors(b))}
 
 
+class WorkspaceMonitor:
+    """Fires when the base leaves the map (by odometry) or a hand goes down to the floor.
+
+    Goals off the map are refused before they start; this is the net under that check (a push, a skid).
+    """
+
+    name = "workspace"
+
+    def __init__(self, robot: RobotController, bounds: np.ndarray, min_hand_height: float) -> None:
+        self.robot = robot
+        self.low, self.high = np.asarray(bounds[0], dtype=float), np.asarray(bounds[1], dtype=float)
+        self.min_hand_height = min_hand_height
+
+    def check(self, now: float) -> str | None:
+        x, y, _ = self.robot.base.pose()
+        if not (np.all([x, y] >= self.low) and np.all([x, y] <= self.high)):
+            return f"the base at ({x:.2f}, {y:.2f}) left the map ({self.low.tolist()} to {self.high.tolist()})"
+        whole_body = self.robot.whole_body
+        for side in self.robot.config.grippers:
+            z = float(whole_body.frame_pose(whole_body.hand_frame(side)).translation[2])
+            if z < self.min_hand_height:
+                return (
+                    f"the {side} hand is {z * 100:.0f} cm above the floor (lowest allowed {self.min_hand_height:g} m)"
+                )
+        return None
+
+
 class TimeBudgetMonitor:
     """Fires when the mission has used its simulation-time budget."""
 

@@ -75,6 +75,7 @@ class SafetyDefaults(StrictModel):
     slow_distance: float = 1.0  # m between the robot and the nearest sensed thing below which it slows
     stop_distance: float = 0.2  # m below which nothing moves towards it (a protective stop)
     hold_limit: float = 10.0  # s a protective stop may hold a motion before the motion fails
+    min_hand_height: float = 0.1  # m above the floor below which a hand trips the workspace monitor
 
 
 class RecoveryDefaults(StrictModel):

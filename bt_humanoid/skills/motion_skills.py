@@ -10,7 +10,7 @@ from pydantic import Field, model_validator
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.skills.base import Skill
 from bt_humanoid.skills.context import CheckContext
-from bt_humanoid.skills.params import check_name
+from bt_humanoid.skills.params import check_in_map, check_name
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel, exactly_one
 
@@ -42,7 +42,10 @@ class MoveBase(Skill):
 
     @classmethod
     def check(cls, params: MoveBaseParams, context: CheckContext) -> list[tuple[str, str]]:
-        return check_name(params.place, context.world.places, "place", "place")
+        problems = check_name(params.place, context.world.places, "place", "place")
+        if not params.relative and params.x is not None and params.y is not None:
+            problems += check_in_map((params.x, params.y), context.world, "x, y")
+        return problems
 
     def start(self) -> MotionHandle:
         p: MoveBaseParams = self.params
@@ -58,6 +61,9 @@ class MoveBase(Skill):
         else:
             x, y = p.x, p.y
             yaw = math.radians(p.yaw) if p.yaw is not None else yaw0
+        outside = self.context.world.outside_map(round(x, 2), round(y, 2))
+        if outside is not None:  # a relative move from here would leave the map: refuse before moving
+            raise ValueError(f"the goal {outside}")
         speed = min(s for s in (p.max_speed, self.context.max_base_speed) if s is not None)
         return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
 
