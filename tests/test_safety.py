@@ -98,7 +98,7 @@ def test_workspace_monitor_fires_off_the_map_and_for_a_hand_near_the_floor():
     run = build_run({"mission": "idle", "tree": {"wait": {"seconds": 0}}})
     bounds = np.array(run.context.world.bounds)
     assert WorkspaceMonitor(run.robot, bounds, 0.1).check(0.0) is None
-    elsewhere = bounds + [[5.0, 5.0], [5.0, 5.0]]  # a map the robot's start is not on
+    elsewhere = bounds + 5.0  # a map the robot's start is not on
     assert "left the map" in WorkspaceMonitor(run.robot, elsewhere, 0.1).check(0.0)
     message = WorkspaceMonitor(run.robot, bounds, 0.6).check(0.0)  # the hands hang about 0.48 m up
     assert message.startswith("the left hand is 48 cm above the floor")
