@@ -2,13 +2,13 @@
 
 The base scanner's hits that are not the map's furniture (a person, a parcel,
 a box that was moved) each set how fast the robot may close in on them: full
-speed beyond ``slow_distance`` from the robot, falling linearly to
-nothing at ``stop_distance`` (a protective stop, in the sense of ISO/TS 15066).
-Moving away or sideways is always allowed, so a robot that someone stands
-close to can still make way. The robot's parts are the base and the hands:
-turning moves a hand that reaches out, and that counts as closing in too.
-Nothing latches: the motion goes
-on when the way clears, and a motion held too long fails (``hold_limit``).
+speed beyond ``slow_distance``, falling linearly to nothing at
+``stop_distance`` (a protective stop, in the sense of ISO/TS 15066). Moving
+away or sideways is always allowed, so a robot that someone stands close to
+can still make way. The robot's parts are the base and the hands: turning
+moves a hand that reaches out, and that counts as closing in too. Nothing
+latches: the motion goes on when the way clears, and a motion held too long
+fails (``hold_limit``).
 """
 
 from __future__ import annotations
