@@ -6,7 +6,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import yaml
 from pydantic import BaseModel, ValidationError
@@ -14,6 +14,7 @@ from pydantic import BaseModel, ValidationError
 from bt_humanoid.errors import UserError, describe_validation_error, did_you_mean
 
 YamlPath = tuple[str | int, ...]
+M = TypeVar("M", bound=BaseModel)
 
 
 def display_path(path: Path) -> str:
@@ -77,6 +78,18 @@ def read_yaml(file: Path, text: str | None = None) -> YamlSource:
         raise UserError("nested too deeply to read", where=display_path(file)) from None
     finally:
         loader.dispose()
+
+
+def read_model(file: Path, model: type[M], shape: str) -> tuple[M, YamlSource]:
+    """A YAML mapping read into ``model``, with its source; ``shape`` says what the file should be when it is not
+    a mapping. Every error is a UserError at file:line."""
+    source = read_yaml(file)
+    if not isinstance(source.data, dict):
+        raise UserError(shape, where=source.where(()))
+    try:
+        return model.model_validate(source.data), source
+    except ValidationError as error:
+        raise source.invalid(error) from None
 
 
 def read_config(

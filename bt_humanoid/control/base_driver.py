@@ -57,7 +57,6 @@ class BaseDriver:
         self.reference = io.positions().copy()
         self.handle: MotionHandle | None = None
         self.trajectory: Trajectory | None = None
-        self.start = 0.0
         self.target = self.reference.copy()
         self.braking = False
         self.tracking = False  # following references streamed by the whole-body controller
@@ -112,8 +111,7 @@ class BaseDriver:
             np.array([lin * direction[0], lin * direction[1], ang]) for lin, ang in zip(linear, angular, strict=False)
         )
         self.trajectory = plan_trajectory(start, self.velocity, self.acceleration, target, plan_limits, phase_sync=True)
-        self.start = self.io.time
-        self.elapsed, self.held_since, self.last_step = 0.0, None, self.io.time
+        self._begin_plan()
         self.planned_velocity = self.velocity.copy()
         self.target = target
         self.braking = self.tracking = False
@@ -146,8 +144,11 @@ class BaseDriver:
         self.trajectory = plan_trajectory(
             self.reference, self.velocity, self.acceleration, None, plan_limits, brake=True
         )
-        self.start = self.io.time
+        self._begin_plan()
         self.braking = True
+
+    def _begin_plan(self) -> None:
+        self.elapsed, self.held_since, self.last_step = 0.0, None, self.io.time
 
     def step(self) -> None:
         """Sample the plan, correct the tracking error, command the actuators."""
@@ -161,13 +162,10 @@ class BaseDriver:
             return
         now = self.io.time
         step, self.last_step = now - self.last_step, now
-        share = 1.0
-        if self.braking:
-            elapsed = now - self.start
-        else:  # plan time runs at the share the limiter allows: the path stays, the pace drops
-            share = self.allowed_share(self.planned_velocity)
-            self.elapsed += share * step
-            elapsed = self.elapsed
+        # plan time runs at the share the limiter allows: the path stays, the pace drops (braking is never slowed)
+        share = 1.0 if self.braking else self.allowed_share(self.planned_velocity)
+        self.elapsed += share * step
+        elapsed = self.elapsed
         position, velocity, acceleration = self.trajectory.at_time(min(elapsed, self.trajectory.duration))
         self.reference = np.array(position)
         self.planned_velocity = np.array(velocity)

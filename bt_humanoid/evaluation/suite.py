@@ -13,14 +13,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, model_validator
 
 from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.evaluation.faults import FAULT_MODELS, FaultConfig
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.strict_model import StrictModel, exactly_one
-from bt_humanoid.yaml_source import YamlSource, read_yaml
+from bt_humanoid.yaml_source import YamlSource, read_model
 
 
 class Task(StrictModel):
@@ -84,13 +84,7 @@ class Suite(StrictModel):
 
 def load_suite(file: Path) -> tuple[Suite, WorldConfig]:
     """A validated suite and its world; a UserError at file:line for anything wrong."""
-    source = read_yaml(file)
-    if not isinstance(source.data, dict):
-        raise UserError("a suite is a mapping (suite:, tasks:, ...)", where=source.where(()))
-    try:
-        suite = Suite.model_validate(source.data)
-    except ValidationError as error:
-        raise source.invalid(error) from None
+    suite, source = read_model(file, Suite, "a suite is a mapping (suite:, tasks:, ...)")
     world = _world(suite, source)
     _check_names(suite, world, source)
     _check_tasks(suite, source)

@@ -12,12 +12,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, ValidationError, create_model
+from pydantic import BaseModel, Field, create_model
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.strict_model import StrictModel
-from bt_humanoid.yaml_source import YamlSource, read_yaml
+from bt_humanoid.yaml_source import YamlSource, read_model
 
 _TYPES: dict[str, Any] = {"string": str, "number": float, "integer": int, "boolean": bool, "any": Any}
 PLACEHOLDER = re.compile(r"\$\{([A-Za-z_][A-Za-z0-9_]*)\}")
@@ -61,13 +61,7 @@ def _args_model(name: str, header: BehaviorHeader) -> type[BaseModel]:
 
 def load_behavior(file: Path) -> Behavior:
     """Read and check one behaviour file (its header; the tree is checked when expanded)."""
-    source = read_yaml(file)
-    if not isinstance(source.data, dict):
-        raise UserError("a behaviour file is a mapping with behavior, params and tree", where=source.where(()))
-    try:
-        header = BehaviorHeader.model_validate(source.data)
-    except ValidationError as error:
-        raise source.invalid(error) from None
+    header, source = read_model(file, BehaviorHeader, "a behaviour file is a mapping with behavior, params and tree")
     return Behavior(header.behavior, header.description, source, _args_model(header.behavior, header), header.example)
 
 

@@ -1,7 +1,7 @@
 """The head camera's depth channel, as rays: where each pixel's ray meets the scene.
 
 A depth camera measures, per pixel, the distance along its ray to the first
-surface. Casting those rays with ``mj_multiRay`` gives the same numbers a
+surface. Casting those rays (``raycast``) gives the same numbers a
 rendered depth image would, at a fraction of the cost, so mapping can run at
 the camera rate. The rays sample the image on a coarse grid (mapping needs
 no more); hits on the robot's own body are dropped. RGB detection renders
@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+
+from bt_humanoid.perception.raycast import cast_rays
 
 MAX_RANGE = 6.0  # m: beyond this a depth camera of this kind returns nothing
 
@@ -74,20 +76,7 @@ class DepthCamera:
         origin = self.data.cam_xpos[self.camera].copy()
         rotation = self.data.cam_xmat[self.camera].reshape(3, 3)
         directions = self._rays @ rotation.T
-        mujoco.mj_multiRay(
-            self.model,
-            self.data,
-            origin,
-            directions.ravel(),
-            None,
-            1,
-            -1,
-            self._geom_ids,
-            self._distances,
-            None,
-            len(directions),
-            MAX_RANGE,
-        )
+        cast_rays(self.model, self.data, origin, directions, MAX_RANGE, self._geom_ids, self._distances)
         ranges = np.where(self._geom_ids >= 0, self._distances, np.inf)
         own = (self._geom_ids >= 0) & self._robot_geoms[np.maximum(self._geom_ids, 0)]
         return DepthScan(origin, directions, ranges, own)

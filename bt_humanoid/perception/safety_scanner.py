@@ -2,7 +2,7 @@
 
 Mobile robots that work near people carry one (the head camera looks where
 the robot goes; the scanner also sees who comes from the side or behind).
-Each ray is cast through the scene with ``mj_multiRay`` from the scanner's
+Each ray is cast through the scene (``raycast``) from the scanner's
 current pose, as a real scanner measures time of flight; the robot's own
 base is skipped, as a scanner's housing is.
 """
@@ -14,11 +14,12 @@ import math
 import mujoco
 import numpy as np
 
+from bt_humanoid.perception.raycast import cast_rays
 from bt_humanoid.sim.robot_config import ScannerConfig
 
 
 class SafetyScanner:
-    """``scan()`` returns the floor points (x, y) where the rays hit something, at the scanner's rate."""
+    """``scan()`` gives the floor points (x, y) where the rays hit something, once per scan period."""
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, base_body: int, config: ScannerConfig) -> None:
         self.model, self.data = model, data
@@ -30,13 +31,12 @@ class SafetyScanner:
         self._distances = np.zeros(config.rays)
         self.period = 1.0 / config.rate_hz
         self.last_scan = -math.inf
-        self.points = np.zeros((0, 2))  # the latest scan's hits (world x, y)
 
-    def scan(self) -> np.ndarray:
-        """Hits of a fresh scan when one is due, else the latest ones (world x, y)."""
+    def scan(self) -> np.ndarray | None:
+        """The hits of a fresh scan (world x, y) when one is due, else None."""
         now = self.data.time
         if now - self.last_scan < self.period - 1e-9:
-            return self.points
+            return None
         self.last_scan = now
         position = self.data.xpos[self.base_body]
         yaw = math.atan2(self.data.xmat[self.base_body][3], self.data.xmat[self.base_body][0])
@@ -44,20 +44,15 @@ class SafetyScanner:
         directions[:, 0] = np.cos(self._angles + yaw)
         directions[:, 1] = np.sin(self._angles + yaw)
         origin = np.array([position[0], position[1], self.config.height])
-        mujoco.mj_multiRay(
+        cast_rays(
             self.model,
             self.data,
             origin,
-            directions.ravel(),
-            None,
-            1,
-            self.base_body,
+            directions,
+            self.config.range,
             self._geom_ids,
             self._distances,
-            None,
-            self.config.rays,
-            self.config.range,
+            self.base_body,
         )
         hit = self._geom_ids >= 0
-        self.points = origin[:2] + directions[hit, :2] * self._distances[hit, None]
-        return self.points
+        return origin[:2] + directions[hit, :2] * self._distances[hit, None]

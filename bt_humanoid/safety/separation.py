@@ -52,11 +52,13 @@ class SpeedAndSeparation:
         self._parts = np.zeros((0, 2))  # the robot's parts as discs on the floor: the base, then each hand
         self._arms = np.zeros((0, 2))  # each part's centre from the base centre: it swings when the base turns
         self._radii = np.zeros(0)
-        self._gaps = np.zeros(0)  # per part: m to the nearest sensed thing
+        self._near_gaps = np.zeros(0)  # per part: m to the nearest of those
 
     def update(self, base_xy: np.ndarray) -> None:
-        """Scan, and find what is near the base or a hand."""
+        """On each fresh scan: what is near the base or a hand, as the robot stood when the scan was taken."""
         points = self.scanner.scan()
+        if points is None:
+            return  # between scans: keep the last picture (the points and the parts of one instant)
         if len(points):
             near_person = np.zeros(len(points), dtype=bool)
             for person in self.people():
@@ -66,9 +68,10 @@ class SpeedAndSeparation:
         self._parts = base_xy + self._arms
         self._radii = np.array([self.footprint] + [HAND_RADIUS] * (len(self._arms) - 1))
         gaps = self._gaps_of(self._parts, points)  # (points, parts)
-        self._points = points[np.any(gaps < self.slow, axis=1)]
-        self._gaps = gaps.min(axis=0) if len(points) else np.full(len(self._parts), np.inf)
-        self.distance = float(self._gaps.min())
+        near = np.any(gaps < self.slow, axis=1)
+        self._points = points[near]
+        self._near_gaps = gaps[near].min(axis=0) if np.any(near) else np.full(len(self._parts), np.inf)
+        self.distance = float(gaps.min()) if gaps.size else np.inf
         self._update_zone()
 
     def share(self, velocity: np.ndarray) -> float:
@@ -83,7 +86,7 @@ class SpeedAndSeparation:
         # each part moves with the base and, when the base turns, at right angles to its arm
         moving = np.array([vx, vy]) + yaw_rate * np.stack([-self._arms[:, 1], self._arms[:, 0]], axis=1)
         ahead = self._gaps_of(self._parts + moving * LOOK_AHEAD, self._points).min(axis=0)
-        now = self._gaps_of(self._parts, self._points).min(axis=0)
+        now = self._near_gaps
         closing = np.maximum(now - ahead, 0.0) / LOOK_AHEAD
         allowed = self.max_speed * np.clip((now - self.stop) / (self.slow - self.stop), 0.0, 1.0)
         limited = closing > allowed + 1e-6

@@ -31,12 +31,12 @@ class Simulation:
         self.model = self.spec.compile()
         self.data = mujoco.MjData(self.model)
         self.timestep = float(self.model.opt.timestep)
-        root_id = int(self.model.body_rootid[self.model.joint(robot.base.joints["x"]).bodyid[0]])
-        root = self.model.body(root_id).name
+        root = int(self.model.body_rootid[self.model.joint(robot.base.joints["x"]).bodyid[0]])
         #: every body of the robot: the tree under the body its base joints move
-        self.robot_bodies = {b for b in range(self.model.nbody) if self.model.body_rootid[b] == root_id}
+        self.robot_bodies = {b for b in range(self.model.nbody) if self.model.body_rootid[b] == root}
         self.walkers = [
-            WalkerDriver(self.model, self.data, name, walker, root) for name, walker in world.walkers.items()
+            WalkerDriver(self.model, self.data, name, walker, root, self.robot_bodies)
+            for name, walker in world.walkers.items()
         ]
         self.reset()
 

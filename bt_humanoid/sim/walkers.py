@@ -28,14 +28,16 @@ PATIENCE = 3.0  # s a walker waits for the robot before turning back
 class WalkerDriver:
     """Commands one walker's actuators every control step."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, name: str, walker: Walker, robot_root: str) -> None:
+    def __init__(
+        self, model: mujoco.MjModel, data: mujoco.MjData, name: str, walker: Walker, robot_root: int, robot: set[int]
+    ) -> None:
         self.data = data
         self.walker = walker
         self.route = np.array(walker.route, dtype=float)
         self.joints = [model.joint(f"{name}_{axis}").qposadr[0] for axis in ("x", "y")]
         self.actuators = [model.actuator(f"{name}_{axis}").id for axis in ("x", "y")]
-        self.robot = model.body(robot_root).id
-        self.robot_parts = np.flatnonzero(model.body_rootid == self.robot)
+        self.robot = robot_root  # the body the robot's base joints move
+        self.robot_parts = np.array(sorted(robot))  # every body of the robot
         self.target = 1 % len(self.route)
         self.direction = 1  # along the route's corners, or -1 the other way round
         self.start = self.route[0]
