@@ -22,6 +22,7 @@ from bt_humanoid.language.embedded import MAX_STEP, EmbeddedPlanner, is_stop
 from bt_humanoid.language.listening import Listener, heard_in
 from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
+from bt_humanoid.language.questions import Questions
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.perception.grounding import resolve
@@ -137,7 +138,8 @@ class InteractiveSession:
     """Typed commands and answers, one after another, on one simulation: the robot keeps its place and belief.
 
     ``lines`` delivers what the person types (None when they are done). While a mission runs, a typed "stop"
-    stops it at once; anything else typed meanwhile waits until the robot is free.
+    stops it at once, a line while the robot asks whether to try again answers that, and anything else typed
+    meanwhile waits until the robot is free.
     """
 
     def __init__(
@@ -156,10 +158,12 @@ class InteractiveSession:
         self.pending: deque[str] = deque()
         idle = {"mission": "ready", "world": world, "robot": robot, "tree": {"wait": {"seconds": 0}}}
         self.run = MissionRun(MissionLoader().load_data(idle, name="<interactive>"), speak=say)
+        self.questions = Questions(say)  # a recovery that asks whether to try again, while a mission runs
+        self.run.context.questions = self.questions
         self.run.executor.observers.append(self._listen_while_busy)
         self.results: list[Any] = []
         self.finished = False
-        self.awaiting_answer = False  # a question is out: the next line is its answer
+        self.planner_asking = False  # the planner's question is out: the next line is its answer
         if self.run.perceiver is not None:
             self.run.perceiver.look()
 
@@ -193,13 +197,18 @@ class InteractiveSession:
             return  # it said that it stopped
         self.say("Done." if result.success else f"I could not finish: {result.cause or result.tree_status}.")
 
+    @property
+    def awaiting_answer(self) -> bool:
+        """A question is out (the planner's, or a recovery's): the next line is its answer."""
+        return self.planner_asking or self.questions.pending is not None
+
     def _ask(self, question: str) -> str | None:
         self.say(question)
-        self.awaiting_answer = True
+        self.planner_asking = True
         try:
             return self._next_line()
         finally:
-            self.awaiting_answer = False
+            self.planner_asking = False
 
     def _next_line(self) -> str | None:
         if self.pending:
@@ -222,6 +231,8 @@ class InteractiveSession:
                 return
             if self.run.stop_monitor.reason is None and is_stop(line):
                 self.run.request_stop("stop (typed)")
+            elif self.questions.pending is not None:
+                self.questions.answer(line)
             else:
                 self.pending.append(line)
 

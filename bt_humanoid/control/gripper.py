@@ -71,3 +71,7 @@ class GripperController:
         idx = self.joints.indices(config.joints)
         commanded_closed = np.allclose(self.joints.position[idx], config.closed, atol=1e-4)
         return bool(commanded_closed and self.width(side) > EMPTY_WIDTH)
+
+    def shut(self, side: str) -> bool:
+        """The pads are together: nothing is between them."""
+        return self.width(side) <= EMPTY_WIDTH

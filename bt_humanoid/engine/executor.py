@@ -49,6 +49,11 @@ class Executor:
         self._running: list[Behaviour] = []
         self._violation_logged = False
 
+    @property
+    def running(self) -> list[Behaviour]:
+        """The mission's nodes running after the last tick."""
+        return self._running
+
     # --- one cycle -------------------------------------------------------------
 
     def tick(self) -> Status:
@@ -57,6 +62,9 @@ class Executor:
         if violation is not None and not self._violation_logged:
             self._violation_logged = True
             self.events.add(violation.time, "safety", monitor=violation.monitor, message=violation.message)
+        for fault in self.compiled.supervisor.faults:
+            node = getattr(fault.leaf, "bt_path", None)
+            self.events.add(fault.time, "monitor", monitor=fault.monitor, message=fault.message, node=node)
         visited = list(self.root.tick())
         self._record(visited)
         self.tick_count += 1

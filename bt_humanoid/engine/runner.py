@@ -12,6 +12,7 @@ import numpy as np
 from py_trees.common import Status
 
 from bt_humanoid.control.robot import RobotController
+from bt_humanoid.engine.decorators import RecoveryPolicy
 from bt_humanoid.engine.events import EventLog
 from bt_humanoid.engine.executor import Executor
 from bt_humanoid.errors import UserError
@@ -24,9 +25,12 @@ from bt_humanoid.perception.perceiver import Perceiver
 from bt_humanoid.perception.safety_scanner import SafetyScanner
 from bt_humanoid.safety.monitors import (
     BumperMonitor,
+    DroppedMonitor,
     JointLimitMonitor,
     SafetySupervisor,
     StopRequestMonitor,
+    StrainMonitor,
+    StuckMonitor,
     TimeBudgetMonitor,
     WorkspaceMonitor,
     trunk_bodies,
@@ -132,19 +136,29 @@ class MissionRun:
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget
         margin = safety.joint_limit_margin if safety.joint_limit_margin is not None else defaults.joint_limit_margin
+        config = spec.known.robot_config
+        speed_limits = [
+            config.motion_limits(j).velocity * defaults.joint_speed_factor for j in self.robot.body_io.joints
+        ]
         monitors = [
             self.stop_monitor,
-            JointLimitMonitor(self.robot, margin),
+            BumperMonitor(self.sim.model, self.sim.data, self._trunk(), self.sim.robot_bodies),  # a cause first
+            JointLimitMonitor(self.robot, margin, np.array(speed_limits)),
             TimeBudgetMonitor(self.time_budget, self.sim.time),
-            BumperMonitor(self.sim.model, self.sim.data, self._trunk(), self.sim.robot_bodies),
             WorkspaceMonitor(self.robot, np.array(spec.known.world.bounds), defaults.min_hand_height),
         ]
-        self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time)
+        branch_monitors = [
+            DroppedMonitor(self.robot.grippers, lambda: self.context.world_model),
+            StrainMonitor(self.sim.model, self.sim.data, self._limb_actuators(), defaults.strain_time),
+            StuckMonitor(self.robot, lambda: self.executor.running, defaults.stuck_after),
+        ]
+        self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time, branch_monitors)
 
-        def log_retry(policy) -> None:
-            self.events.add(self.sim.time, "retry", node=policy.decorated.bt_path, message=policy.feedback_message)
+        def log_recovery(policy: RecoveryPolicy, action: str) -> None:
+            # "retry", "replan", "ask" or "answer", with the node that failed and what the policy does about it
+            self.events.add(self.sim.time, action, node=policy.decorated.bt_path, message=policy.feedback_message)
 
-        self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_retry).compile(spec)
+        self.compiled: CompiledMission = Compiler(self.context, self.supervisor, log_recovery).compile(spec)
         observers = self.executor.observers if hasattr(self, "executor") else []
         self.executor = Executor(self.compiled, self.sim, self.robot, self.events, self.tick_hz, self.control_hz)
         self.executor.observers.extend(observers)
@@ -176,6 +190,17 @@ class MissionRun:
         )
         self.robot.monitor_separation(separation)
         return separation
+
+    def _limb_actuators(self) -> list[int]:
+        """Actuators of the arms, waist, lift and head: what the strain monitor watches (not wheels or fingers)."""
+        config, model = self.context.robot_config, self.sim.model
+        fingers = {j for g in config.grippers.values() for j in g.joints}
+        joints = [j for j in self.robot.body_io.joints if j not in fingers]
+        return [
+            a
+            for a in range(model.nu)
+            if model.actuator_trntype[a] == 0 and model.joint(model.actuator_trnid[a, 0]).name in joints
+        ]
 
     def _trunk(self) -> set[int]:
         """The robot's bodies that are not on an arm: what the bumper monitor watches."""

@@ -9,16 +9,16 @@ robot's defaults, in that order.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import py_trees
 from py_trees.behaviour import Behaviour
 from py_trees.common import ParallelPolicy
 
 from bt_humanoid.engine.composites import RoundRobin
-from bt_humanoid.engine.decorators import RecoveryPolicy, SafetyGuard, SimTimeout
-from bt_humanoid.mission.schema import RecoverySettings
+from bt_humanoid.engine.decorators import RecoveryPolicy, RecoverySteps, SafetyGuard, SimTimeout
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
 from bt_humanoid.safety.monitors import SafetySupervisor
 from bt_humanoid.skills import REGISTRY
@@ -49,49 +49,102 @@ def _label(node: NodeSpec) -> str:
     return node.kind
 
 
+def resolve_recovery(*layers: Mapping[str, Any]) -> RecoverySteps:
+    """Each field from the first layer that sets it (layers: most specific first); unset fields keep defaults."""
+    fields = {}
+    for name in ("retries", "backoff", "replan", "ask"):
+        fields[name] = next((layer[name] for layer in layers if layer.get(name) is not None), None)
+    return RecoverySteps(**{k: v for k, v in fields.items() if v is not None})
+
+
 class Compiler:
     def __init__(
         self,
         context: SkillContext,
         supervisor: SafetySupervisor,
-        on_retry: Callable[[RecoveryPolicy], None] | None = None,
+        on_recovery: Callable[[RecoveryPolicy, str], None] | None = None,
     ) -> None:
         self.context = context
         self.supervisor = supervisor
-        self.on_retry = on_retry
+        self.on_recovery = on_recovery
 
     def compile(self, spec: MissionSpec) -> CompiledMission:
-        robot_defaults = self.context.robot_config.recovery
         section = spec.header.recovery
-        self.default_recovery = RecoverySettings(
-            retries=section.retries if section.retries is not None else robot_defaults.retries,
-            backoff=section.backoff if section.backoff is not None else robot_defaults.backoff,
-        )
-        self.skill_recovery = section.skills
+        self.robot_recovery = self.context.robot_config.recovery.model_dump()
+        self.mission_recovery = section.model_dump(exclude={"skills"})
+        self.skill_recovery = {name: s.model_dump(exclude={"alternative"}) for name, s in section.skills.items()}
+        self.skill_alternatives = spec.skill_alternatives
         self.nodes: list[tuple[Behaviour, str]] = []
+        self.awaiting_target: list[RecoveryPolicy] = []  # policies that may replan, waiting for their sequence
         root = self._wrapped(spec.tree)
         return CompiledMission(root, spec, self.supervisor, self.nodes)
 
-    def _recovery_for(self, node: NodeSpec) -> RecoverySettings:
-        if node.recovery is not None:
-            return node.recovery
-        if node.category == "skill":
-            if node.kind in self.skill_recovery:
-                return self.skill_recovery[node.kind]
-            if REGISTRY[node.kind].is_condition:
-                return RecoverySettings(retries=0, backoff=0.0)  # a condition's answer is not a fault
-            return self.default_recovery
-        return RecoverySettings(retries=0, backoff=self.default_recovery.backoff)
+    def _recovery_for(self, node: NodeSpec) -> RecoverySteps:
+        own = node.recovery.model_dump(exclude={"alternative"}) if node.recovery is not None else {}
+        if node.category != "skill":  # a composite's failure was already recovered below
+            backoff = {"backoff": self.mission_recovery["backoff"]}
+            return resolve_recovery(own, backoff, self.robot_recovery)
+        info = REGISTRY[node.kind]
+        per_skill = self.skill_recovery.get(node.kind, {})
+        if info.is_condition:  # a condition's answer is not a fault: mission-wide settings do not apply
+            return resolve_recovery(own, per_skill, info.recovery)
+        return resolve_recovery(own, per_skill, self.mission_recovery, info.recovery, self.robot_recovery)
+
+    def _alternative_for(self, node: NodeSpec) -> NodeSpec | None:
+        if node.alternative is not None:
+            return node.alternative
+        if node.category == "skill" and not node.path.startswith("recovery."):  # no alternative of an alternative
+            return self.skill_alternatives.get(node.kind)
+        return None
+
+    def _policy(self, child: Behaviour, steps: RecoverySteps, what: str) -> RecoveryPolicy:
+        policy = RecoveryPolicy(
+            RECOVERY_NAME,
+            child,
+            steps,
+            self.context.clock,
+            self.supervisor,
+            self.context.questions,
+            self.on_recovery,
+            what,
+        )
+        if steps.replan:
+            self.awaiting_target.append(policy)
+        return policy
 
     def _wrapped(self, node: NodeSpec) -> Behaviour:
+        waiting = len(self.awaiting_target)
         inner = self._build(node)
         inner.bt_path = node.path  # type: ignore[attr-defined]
         self.nodes.append((inner, node.path))
-        policy = self._recovery_for(node)
-        recovery = RecoveryPolicy(
-            RECOVERY_NAME, inner, policy.retries, policy.backoff, self.context.clock, self.supervisor, self.on_retry
-        )
-        return SafetyGuard(GUARD_NAME, recovery, self.supervisor)
+        steps = self._recovery_for(node)
+        what = node.name or node.kind
+        alternative = self._alternative_for(node)
+        if alternative is None:
+            policy = self._policy(inner, steps, what)
+        else:
+            # retries stay with the node; its alternative runs when they are spent; replan and ask come after both
+            first = SafetyGuard(
+                GUARD_NAME,
+                self._policy(inner, replace(steps, replan=0, ask=False), what),
+                self.supervisor,
+                leaf=node.category == "skill",
+            )
+            either = py_trees.composites.Selector(
+                f"{what}, or else", memory=True, children=[first, self._wrapped(alternative)]
+            )
+            either.bt_path = f"{node.path}.or_else"  # type: ignore[attr-defined]
+            self.nodes.append((either, either.bt_path))  # type: ignore[attr-defined]
+            policy = self._policy(either, replace(steps, retries=0), what)
+        if isinstance(inner, py_trees.composites.Sequence) and node.category != "behavior":
+            # a sequence starts over for the nodes below it that replan (up to the next sequence down)
+            for below in self.awaiting_target[waiting:]:
+                if below is not policy:
+                    below.replan_target = policy
+            del self.awaiting_target[waiting:]
+            if steps.replan:
+                self.awaiting_target.append(policy)
+        return SafetyGuard(GUARD_NAME, policy, self.supervisor, leaf=node.category == "skill" and alternative is None)
 
     def _build(self, node: NodeSpec) -> Behaviour:
         label = _label(node)

@@ -97,9 +97,9 @@ class MissionLoader:
         world = _config_at(load_world_config, header.world, source, "world")
         self.checks = CheckContext(robot, world, joint_ranges(robot))
         self._check_success(header, source)
-        self._check_recovery(header, source)
+        alternatives = self._skill_recovery(header, source)
         tree = self._node(data["tree"], source, ("tree",), "tree", stack=())
-        return MissionSpec(header, tree, self.checks, source.file)
+        return MissionSpec(header, tree, self.checks, source.file, alternatives)
 
     # --- nodes ----------------------------------------------------------------------
 
@@ -127,15 +127,20 @@ class MissionLoader:
         name = raw.get("name")
         if name is not None and not isinstance(name, str):
             raise UserError("name must be a string", where=source.where((*ypath, "name")))
-        recovery = None
+        recovery, alternative = None, None
         if "recovery" in raw:
-            try:
-                recovery = RecoverySettings.model_validate(raw["recovery"])
-            except ValidationError as error:
-                raise source.invalid(error, (*ypath, "recovery")) from None
+            recovery, alternative = self._recovery(raw["recovery"], source, (*ypath, "recovery"), node_path, stack)
 
         def spec(**kw: Any) -> NodeSpec:
-            return NodeSpec(kind=kind, path=node_path, where=source.where(bpath), name=name, recovery=recovery, **kw)
+            return NodeSpec(
+                kind=kind,
+                path=node_path,
+                where=source.where(bpath),
+                name=name,
+                recovery=recovery,
+                alternative=alternative,
+                **kw,
+            )
 
         if kind in COMPOSITES:
             if not isinstance(body, list) or not body:
@@ -154,6 +159,21 @@ class MissionLoader:
         raise UserError(
             f"unknown skill or node kind '{kind}'", where=source.where(bpath), hint=did_you_mean(kind, options)
         )
+
+    def _recovery(
+        self, raw: Any, source: YamlSource, ypath: YamlPath, node_path: str, stack: tuple[str, ...]
+    ) -> tuple[RecoverySettings, NodeSpec | None]:
+        """A recovery mapping, and its alternative node loaded like any other (paths ``….alternative.…``)."""
+        try:
+            recovery = RecoverySettings.model_validate(raw)
+        except ValidationError as error:
+            raise source.invalid(error, ypath) from None
+        alternative = None
+        if recovery.alternative is not None:
+            alternative = self._node(
+                recovery.alternative, source, (*ypath, "alternative"), f"{node_path}.alternative", stack
+            )
+        return recovery, alternative
 
     def _decorator(self, kind, body, source, bpath, node_path, stack, spec) -> NodeSpec:
         model = LOADER_BODIES[kind]
@@ -272,14 +292,22 @@ class MissionLoader:
                 if name not in valid:
                     raise UserError(f"success: unknown name '{name}'", where=where, hint=did_you_mean(name, valid))
 
-    def _check_recovery(self, header: MissionHeader, source: YamlSource) -> None:
+    def _skill_recovery(self, header: MissionHeader, source: YamlSource) -> dict[str, NodeSpec]:
+        """Check the per-skill recovery names; load their alternatives (one spec, compiled at each use)."""
+        alternatives = {}
         for skill_name in header.recovery.skills:
+            ypath = ("recovery", "skills", skill_name)
             if skill_name not in REGISTRY:
                 raise UserError(
                     f"recovery: unknown skill '{skill_name}'",
-                    where=source.where(("recovery", "skills", skill_name)),
+                    where=source.where(ypath),
                     hint=did_you_mean(skill_name, REGISTRY),
                 )
+            raw = source.data["recovery"]["skills"][skill_name]
+            _, alternative = self._recovery(raw, source, ypath, f"recovery.{skill_name}", stack=())
+            if alternative is not None:
+                alternatives[skill_name] = alternative
+        return alternatives
 
 
 def _config_at(load: Callable[[str], Any], name: str, source: YamlSource, field: str) -> Any:

@@ -20,14 +20,32 @@ from bt_humanoid.strict_model import StrictModel
 # --- mission-level sections ----------------------------------------------------
 
 
-class RecoverySettings(StrictModel):
-    retries: int = Field(0, ge=0, le=10, description="extra attempts after a failure")
-    backoff: float = Field(0.5, ge=0, le=60, description="simulation seconds between attempts")
+class RecoveryBudget(StrictModel):
+    """After a node fails, in this order: retry it, run its alternative, start the enclosing sequence over
+    (replan), ask the person. A field left out falls back to the mission's per-skill setting, then the
+    mission's, then the skill's own default, then the robot's."""
+
+    retries: int | None = Field(None, ge=0, le=10, description="extra attempts after a failure")
+    backoff: float | None = Field(None, ge=0, le=60, description="simulation seconds between attempts")
+    replan: int | None = Field(
+        None,
+        ge=0,
+        le=5,
+        description="times the enclosing sequence starts over from its first step when this still fails "
+        "(perception looks again, routes and grasps are planned anew)",
+    )
+    ask: bool | None = Field(
+        None, description="when all else failed, ask the person whether to try again (when someone can answer)"
+    )
 
 
-class RecoverySection(StrictModel):
-    retries: int | None = Field(None, ge=0, le=10, description="extra attempts of a failed leaf (default: robot's)")
-    backoff: float | None = Field(None, ge=0, le=60, description="seconds between attempts (default: robot's)")
+class RecoverySettings(RecoveryBudget):
+    alternative: dict[str, Any] | None = Field(
+        None, description="a node (skill, behaviour, tree) to run instead when this one still fails"
+    )
+
+
+class RecoverySection(RecoveryBudget):
     skills: dict[str, RecoverySettings] = Field(default_factory=dict, description="per-skill overrides")
 
 
@@ -175,6 +193,14 @@ def structural_kinds() -> list[str]:
 def json_schema(behaviors: dict[str, type[BaseModel]]) -> dict[str, Any]:
     """JSON Schema of a mission file; ``behaviors`` maps behaviour names to their argument models."""
     bodies = decorator_bodies("Node")
+    node_recovery = create_model(
+        "NodeRecovery",
+        __base__=RecoverySettings,
+        alternative=(
+            "Node | None",
+            Field(None, description=RecoverySettings.model_fields["alternative"].description),
+        ),
+    )
     # "Node" is a forward reference, resolved by model_rebuild below
     kinds: dict[str, tuple[Any, str]] = {k: (list["Node"], d) for k, d in COMPOSITES.items()}  # noqa: F821
     kinds |= {k: (bodies[k], d) for k, d in DECORATOR_DESCRIPTIONS.items()}
@@ -182,7 +208,7 @@ def json_schema(behaviors: dict[str, type[BaseModel]]) -> dict[str, Any]:
     kinds |= {k: (model, model.__doc__ or "") for k, model in behaviors.items()}
     extras = {
         "name": (str | None, Field(None, description="label shown in the live tree and the event log")),
-        "recovery": (RecoverySettings | None, Field(None, description="this node's recovery policy")),
+        "recovery": (node_recovery | None, Field(None, description="this node's recovery policy")),
     }
     models = [
         create_model(
@@ -198,7 +224,7 @@ def json_schema(behaviors: dict[str, type[BaseModel]]) -> dict[str, Any]:
     for model in models[1:]:
         node_union = node_union | model
     namespace = {"Node": node_union}
-    for model in [*bodies.values(), *models]:
+    for model in [node_recovery, *bodies.values(), *models]:
         model.model_rebuild(_types_namespace=namespace)
     mission = create_model(
         "Mission", __base__=MissionHeader, tree=(node_union, Field(description="the behaviour tree"))

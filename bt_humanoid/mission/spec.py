@@ -32,11 +32,14 @@ class NodeSpec:
     children: list[NodeSpec] = field(default_factory=list)
     name: str | None = None
     recovery: RecoverySettings | None = None
+    alternative: NodeSpec | None = None  # run instead when this node still fails (its recovery's alternative)
 
     def walk(self):
         yield self
         for child in self.children:
             yield from child.walk()
+        if self.alternative is not None:
+            yield from self.alternative.walk()
 
 
 @dataclass
@@ -46,3 +49,5 @@ class MissionSpec:
     #: the robot and world configs the mission was checked against
     known: CheckContext
     file: Path | None = None
+    #: per-skill alternatives from the mission's recovery section, compiled afresh wherever the skill is used
+    skill_alternatives: dict[str, NodeSpec] = field(default_factory=dict)

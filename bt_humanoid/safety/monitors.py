@@ -1,8 +1,13 @@
 """Safety monitors, evaluated once per tick by the supervisor that every Safety guard reads.
 
-A monitor looks at the robot and the clock and returns a Violation or None.
-The first violation latches: every guard then halts its branch, the tree
-fails, and the executor brakes the robot to rest.
+Two kinds:
+
+- a **Monitor** guards the whole mission (a stop request, a collision, a joint past its range or speed, the
+  workspace, the time budget). Its first violation latches: every guard then halts its branch, the tree
+  fails, and the executor brakes the robot to rest.
+- a **BranchMonitor** sees a fault in what the robot is doing (an object dropped, a joint straining at its
+  torque limit, a skill that makes no progress). The guard of each running leaf it names halts that leaf,
+  which fails with the monitor's reason, and the leaf's recovery policy takes over.
 """
 
 from __future__ import annotations
@@ -13,8 +18,14 @@ from typing import Protocol
 
 import mujoco
 import numpy as np
+from py_trees.behaviour import Behaviour
 
-from bt_humanoid.control.robot import RobotController
+from bt_humanoid.control.gripper import GripperController
+from bt_humanoid.control.robot import REST_SPEED, RobotController
+from bt_humanoid.perception.world_model import WorldModel
+
+
+OVERSPEED_TIME = 0.5  # s a joint must stay over its speed limit before the guard trips (a knock is shorter)
 
 
 @dataclass(frozen=True)
@@ -24,11 +35,29 @@ class Violation:
     time: float
 
 
+@dataclass(frozen=True)
+class Fault:
+    monitor: str
+    message: str
+    time: float
+    leaf: object | None = None  # the leaf it concerns; None: every running leaf
+
+    def concerns(self, leaf: object) -> bool:
+        return self.leaf is None or self.leaf is leaf
+
+
 class Monitor(Protocol):
     name: str
 
     def check(self, now: float) -> str | None:
         """A message when the monitor fires, else None."""
+
+
+class BranchMonitor(Protocol):
+    name: str
+
+    def faults(self, now: float) -> list[tuple[object | None, str]]:
+        """(leaf or None for every running leaf, message) for each fault seen now."""
 
 
 class StopRequestMonitor:
@@ -47,23 +76,36 @@ class StopRequestMonitor:
 
 
 class JointLimitMonitor:
-    """Fires when a joint is past its MJCF range by more than the margin."""
+    """Fires when a joint is past its MJCF range by more than the margin, or faster than its speed limit.
+
+    ``speed_limits`` (rad/s or m/s per joint, already with any allowance) catch a controller gone wrong: the
+    trajectories never ask for more than the robot.yaml limits. A joint must stay over its limit for
+    ``OVERSPEED_TIME``: a knock (the base bumping into something) swings a wrist fast for an instant.
+    """
 
     name = "joint_limits"
 
-    def __init__(self, robot: RobotController, margin: float) -> None:
+    def __init__(self, robot: RobotController, margin: float, speed_limits: np.ndarray | None = None) -> None:
         io = robot.body_io
         self.io = io
         self.lower = np.where(io.limited, io.lower - margin, -np.inf)
         self.upper = np.where(io.limited, io.upper + margin, np.inf)
+        self.speed_limits = speed_limits if speed_limits is not None else np.full(len(io.joints), np.inf)
+        self.fast_since = np.full(len(io.joints), np.inf)
 
     def check(self, now: float) -> str | None:
         q = self.io.positions()
         bad = np.flatnonzero((q < self.lower) | (q > self.upper))
-        if bad.size == 0:
-            return None
-        i = int(bad[0])
-        return f"joint {self.io.joints[i]} at {q[i]:.3f} outside [{self.lower[i]:.3f}, {self.upper[i]:.3f}]"
+        if bad.size:
+            i = int(bad[0])
+            return f"joint {self.io.joints[i]} at {q[i]:.3f} outside [{self.lower[i]:.3f}, {self.upper[i]:.3f}]"
+        speeds = np.abs(self.io.velocities())
+        self.fast_since = np.where(speeds > self.speed_limits, np.minimum(self.fast_since, now), np.inf)
+        fast = np.flatnonzero(now - self.fast_since >= OVERSPEED_TIME)
+        if fast.size:
+            i = int(fast[0])
+            return f"joint {self.io.joints[i]} moving at {speeds[i]:.2f}/s, over its limit {self.speed_limits[i]:.2f}/s"
+        return None
 
 
 class BumperMonitor:
@@ -171,20 +213,120 @@ class TimeBudgetMonitor:
         return None
 
 
-class SafetySupervisor:
-    """Runs the monitors once per tick; the first violation latches."""
+class DroppedMonitor:
+    """Fires when a hand the robot believes holds something has shut on nothing: the object was dropped.
 
-    def __init__(self, monitors: list[Monitor], clock: Callable[[], float]) -> None:
+    The fingers are the sensor: what they hold keeps them apart (a hand lets go only after the belief says
+    so). The belief is corrected at
+    once (the object is no longer held; where it fell is unknown until it is seen), so it fires once per drop.
+    """
+
+    name = "dropped"
+
+    def __init__(self, grippers: GripperController, world_model: Callable[[], WorldModel]) -> None:
+        self.grippers = grippers
+        self.world_model = world_model
+
+    def faults(self, now: float) -> list[tuple[object | None, str]]:
+        found = []
+        for side in self.grippers.grippers:
+            held = self.world_model().held(side)
+            if held is None or not self.grippers.shut(side):
+                continue
+            held.held_by, held.confidence = None, 0.0
+            found.append((None, f"the {held.name} fell out of the {side} hand"))
+        return found
+
+
+class StrainMonitor:
+    """Fires when a joint has pressed at its actuator's force limit for ``strain_time``: it is pushing
+    against something it cannot move (a table edge, a stuck object) or carrying more than it can.
+
+    Base wheels and fingers are left out: drives and grips press at their limits by design.
+    """
+
+    name = "strain"
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, actuators: list[int], strain_time: float) -> None:
+        self.model, self.data = model, data
+        self.actuators = np.asarray(actuators, dtype=int)
+        self.limits = np.abs(model.actuator_forcerange[self.actuators]).min(axis=1)
+        self.strain_time = strain_time
+        self.since = np.full(len(self.actuators), np.inf)  # when each started pressing at its limit
+
+    def faults(self, now: float) -> list[tuple[object | None, str]]:
+        pressing = np.abs(self.data.actuator_force[self.actuators]) >= 0.99 * self.limits
+        self.since = np.where(pressing, np.minimum(self.since, now), np.inf)
+        strained = np.flatnonzero(now - self.since >= self.strain_time)
+        if strained.size == 0:
+            return []
+        i = int(strained[0])
+        self.since[i] = np.inf  # once per strain: the leaf it stops brakes, and the force falls
+        name = self.model.actuator(int(self.actuators[i])).name
+        return [(None, f"{name} pressed at its torque limit ({self.limits[i]:g}) for {self.strain_time:g} s")]
+
+
+class StuckMonitor:
+    """Fires for a running leaf with a motion under way that has made no progress for ``stuck_after``
+    seconds: the robot stands still and the leaf's feedback has not changed (a wait that counts down, or a
+    navigator that re-plans, is progress)."""
+
+    name = "stuck"
+
+    def __init__(self, robot: RobotController, running: Callable[[], list[Behaviour]], stuck_after: float) -> None:
+        self.robot = robot
+        self.running = running
+        self.stuck_after = stuck_after
+        self.last: dict[int, tuple[str, float]] = {}  # per leaf: (feedback, when it last changed or moved)
+
+    def faults(self, now: float) -> list[tuple[object | None, str]]:
+        moving = self.robot.max_speed() > REST_SPEED
+        found: list[tuple[object | None, str]] = []
+        last = {}
+        for leaf in self.running():
+            motion = getattr(leaf, "motion", None)
+            if motion is None or motion.done:
+                continue
+            feedback, since = self.last.get(id(leaf), (leaf.feedback_message, now))
+            if moving or feedback != leaf.feedback_message:
+                feedback, since = leaf.feedback_message, now
+            if now - since >= self.stuck_after:
+                found.append((leaf, f"no progress for {self.stuck_after:g} s ({feedback or 'no feedback'})"))
+                since = now
+            last[id(leaf)] = (feedback, since)
+        self.last = last
+        return found
+
+
+class SafetySupervisor:
+    """Runs the monitors once per tick: the first violation latches; branch faults last one tick."""
+
+    def __init__(
+        self,
+        monitors: list[Monitor],
+        clock: Callable[[], float],
+        branch_monitors: list[BranchMonitor] | None = None,
+    ) -> None:
         self.monitors = monitors
+        self.branch_monitors = branch_monitors or []
         self.clock = clock
         self.violation: Violation | None = None
+        self.faults: list[Fault] = []  # this tick's
 
     def update(self) -> Violation | None:
+        now = self.clock()
         if self.violation is None:
-            now = self.clock()
             for monitor in self.monitors:
                 message = monitor.check(now)
                 if message is not None:
                     self.violation = Violation(monitor.name, message, now)
                     break
+        self.faults = []
+        if self.violation is None:
+            for branch_monitor in self.branch_monitors:
+                for leaf, message in branch_monitor.faults(now):
+                    self.faults.append(Fault(branch_monitor.name, message, now, leaf))
         return self.violation
+
+    def fault_for(self, leaf: object) -> Fault | None:
+        return next((fault for fault in self.faults if fault.concerns(leaf)), None)

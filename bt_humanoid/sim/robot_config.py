@@ -76,6 +76,9 @@ class SafetyDefaults(StrictModel):
     stop_distance: float = 0.2  # m below which nothing moves towards it (a protective stop)
     hold_limit: float = 10.0  # s a protective stop may hold a motion before the motion fails
     min_hand_height: float = 0.1  # m above the floor below which a hand trips the workspace monitor
+    joint_speed_factor: float = 1.5  # a joint faster than this times its velocity limit trips the guard
+    strain_time: float = 1.0  # s a joint may press at its torque limit before what it does is halted
+    stuck_after: float = 20.0  # s a motion may make no progress (robot still, same feedback) before it fails
 
 
 class RecoveryDefaults(StrictModel):

@@ -31,7 +31,8 @@ class LookAtParams(StrictModel):
         return self
 
 
-@skill("look_at", "turn the head so the camera looks at an object or a point")
+# an object no longer where it was seen is looked for again by the steps before (find), once
+@skill("look_at", "turn the head so the camera looks at an object or a point", recovery={"replan": 1})
 class LookAt(_ManipulationSkill):
     Params = LookAtParams
 

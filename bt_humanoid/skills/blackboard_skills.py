@@ -41,7 +41,10 @@ class Check(Skill):
                 ok = bool(_COMPARISONS[p.op](board.get(p.key), p.value))
             except TypeError:
                 ok = False
-        self.feedback_message = f"{p.key} {p.op} {p.value!r}: {'yes' if ok else 'no'}"
+        if p.op == "exists":
+            self.feedback_message = f"{p.key} is {'' if ok else 'not '}on the blackboard"
+        else:
+            self.feedback_message = f"{p.key} {p.op} {p.value!r}: {'yes' if ok else 'no'}"
         return Status.SUCCESS if ok else Status.FAILURE
 
 

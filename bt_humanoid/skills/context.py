@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bt_humanoid.control.robot import RobotController
+from bt_humanoid.language.questions import Questions
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.perceiver import Perceiver
 from bt_humanoid.perception.world_model import WorldModel
@@ -55,3 +56,4 @@ class SkillContext(CheckContext):
     world_model: WorldModel = field(default_factory=WorldModel)  # what the robot believes; skills read only this
     navigator: Navigator | None = None  # plans and follows routes for the base
     perceiver: Perceiver | None = None  # fills the world model from the head camera (robots that have one)
+    questions: Questions | None = None  # someone to ask (interactive runs); None when no one can answer

@@ -99,7 +99,12 @@ class StandNearParams(StrictModel):
 STANCE_ARRIVAL = 0.15  # m: the first and last stretch at a stance may graze the map's margin round furniture
 
 
-@skill("stand_near", "drive (straight, short) to a stance from which one hand reaches an object or a surface spot")
+# a stance that cannot be reached may be reachable from a fresh look (the object seen anew, the way clear)
+@skill(
+    "stand_near",
+    "drive (straight, short) to a stance from which one hand reaches an object or a surface spot",
+    recovery={"replan": 1},
+)
 class StandNear(_ManipulationSkill):
     Params = StandNearParams
 
@@ -184,7 +189,12 @@ class GraspParams(StrictModel):
     side: Side = Field("right", description="which hand")
 
 
-@skill("grasp", "pick up an object within reach: pre-grasp above it, descend, close, lift, verify, carry")
+# a missed grasp is tried again from the same stance (re-reading the object's pose), then from a new approach
+@skill(
+    "grasp",
+    "pick up an object within reach: pre-grasp above it, descend, close, lift, verify, carry",
+    recovery={"retries": 1, "replan": 1},
+)
 class Grasp(_ManipulationSkill):
     Params = GraspParams
 
@@ -300,7 +310,12 @@ class PutParams(StrictModel):
     side: Side = Field("right", description="the hand holding the object")
 
 
-@skill("put", "put the held object down on a surface: above the spot, lower until contact, release, retreat")
+# a put that failed (the spot blocked, out of reach) is tried again from a new stance
+@skill(
+    "put",
+    "put the held object down on a surface: above the spot, lower until contact, release, retreat",
+    recovery={"replan": 1},
+)
 class Put(_ManipulationSkill):
     Params = PutParams
 

@@ -36,7 +36,12 @@ class MoveBaseParams(StrictModel):
         return self
 
 
-@skill("move_base", "drive the base to a named place or a pose, world or relative, with smooth limited velocities")
+# a drive held up (a protective stop, a bump) is worth one more go once the way may have cleared
+@skill(
+    "move_base",
+    "drive the base to a named place or a pose, world or relative, with smooth limited velocities",
+    recovery={"retries": 1, "backoff": 1.0},
+)
 class MoveBase(Skill):
     Params = MoveBaseParams
 

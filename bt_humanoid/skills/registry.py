@@ -6,9 +6,9 @@ and the LLM prompt) are all generated from it.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 from pydantic import BaseModel
 
@@ -23,18 +23,27 @@ class SkillInfo:
     behaviour: type[Skill]
     description: str
     is_condition: bool = False
+    #: this skill's own recovery defaults (retries, backoff, replan, ask); the mission's settings win
+    recovery: Mapping[str, Any] = field(default_factory=dict)
 
 
 REGISTRY: dict[str, SkillInfo] = {}
 
 
-def skill(name: str, description: str, *, condition: bool = False) -> Callable[[type[Skill]], type[Skill]]:
-    """Class decorator: register a Skill subclass (its ``Params`` model is the parameter schema)."""
+def skill(
+    name: str, description: str, *, condition: bool = False, recovery: Mapping[str, Any] | None = None
+) -> Callable[[type[Skill]], type[Skill]]:
+    """Class decorator: register a Skill subclass (its ``Params`` model is the parameter schema).
+
+    A condition's failure is an answer, not a fault: it is never retried unless a mission says so.
+    """
+    if condition:
+        recovery = {"retries": 0, "replan": 0, "ask": False, **(recovery or {})}
 
     def register(cls: type[Skill]) -> type[Skill]:
         if name in REGISTRY:
             raise ValueError(f"skill '{name}' registered twice")
-        REGISTRY[name] = SkillInfo(name, cls.Params, cls, description, condition)
+        REGISTRY[name] = SkillInfo(name, cls.Params, cls, description, condition, dict(recovery or {}))
         cls.skill_name = name
         return cls
 

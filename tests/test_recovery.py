@@ -1,0 +1,154 @@
+"""Recovery policies: retry with backoff, replan (start the enclosing sequence over), an alternative, ask."""
+
+import pytest
+
+from bt_humanoid.engine.decorators import RecoverySteps
+from bt_humanoid.language.questions import Answer, Questions, read_answer
+from bt_humanoid.mission.compiler import resolve_recovery
+from bt_humanoid.testing.scenario import Scenario, build_run, run_scenario
+
+NEVER = {"check": {"key": "never", "op": "exists"}}  # a leaf that fails every time
+
+
+def run(tree, **header):
+    return run_scenario({"mission": "t", "tree": tree, **header})
+
+
+def events(scenario, kind):
+    return [e for e in scenario.events if e["event"] == kind]
+
+
+def test_fields_come_from_the_most_specific_layer_that_sets_them():
+    node, mission, skill, robot = {"retries": 3}, {"retries": 1, "backoff": 2.0}, {"replan": 1}, {"backoff": 0.5}
+    assert resolve_recovery(node, mission, skill, robot) == RecoverySteps(retries=3, backoff=2.0, replan=1)
+    assert resolve_recovery({}, {"retries": None}, robot) == RecoverySteps(retries=0, backoff=0.5)
+
+
+def test_replan_starts_the_enclosing_sequence_over():
+    tree = {"sequence": [{"say": {"text": "looking"}}, {**NEVER, "recovery": {"replan": 2, "backoff": 0.5}}]}
+    s = run(tree)
+    assert s.result.tree_status == "FAILURE"
+    assert s.result.said == ["looking"] * 3  # the first run and two replans
+    replans = events(s, "replan")
+    assert [e["node"] for e in replans] == ["sequence"] * 2
+    assert "starting over after check" in replans[0]["message"]
+    assert replans[1]["t"] - replans[0]["t"] == pytest.approx(0.5, abs=0.06)
+
+
+def test_replan_reaches_the_nearest_sequence_through_decorators_and_fallbacks():
+    inner = {"fallback": [{"invert": {"child": {"say": {"text": "plan a"}}}}, {**NEVER, "recovery": {"replan": 1}}]}
+    tree = {"sequence": [{"say": {"text": "start"}}, {"sequence": [{"say": {"text": "inner"}}, inner]}]}
+    s = run(tree)
+    assert s.result.said == ["start", "inner", "plan a", "inner", "plan a"]  # the inner sequence, not the outer
+    assert [e["node"] for e in events(s, "replan")] == ["sequence[1].sequence"]
+
+
+def test_replan_then_succeeds_when_the_world_changed():
+    # the condition holds only after 1.2 s: the third start of the sequence finds it set
+    tree = {
+        "parallel": {
+            "policy": "all",
+            "children": [
+                {"sequence": [{"wait": {"seconds": 1.2}}, {"set": {"key": "ready", "value": True}}]},
+                {"sequence": [{"wait": {"seconds": 0.1}}, {"check": {"key": "ready", "op": "exists"}, "recovery": {"replan": 3}}]},
+            ],
+        }
+    }
+    s = run(tree)
+    assert s.result.tree_status == "SUCCESS"
+    assert 1 <= len(events(s, "replan")) <= 3
+
+
+def test_the_skill_default_replans_and_the_mission_can_turn_it_off():
+    tree = {"sequence": [{"say": {"text": "go"}}, {**NEVER, "recovery": {"replan": 1}}]}
+    assert run(tree).result.said == ["go", "go"]
+    off = run(tree, recovery={"skills": {"check": {"replan": 0}}})
+    assert off.result.said == ["go", "go"], "the node's own setting wins over the mission's per-skill one"
+    plain = {"sequence": [{"say": {"text": "go"}}, NEVER]}
+    assert run(plain, recovery={"replan": 1}).result.said == ["go"], "conditions ignore mission-wide settings"
+
+
+def test_grasp_defaults_to_one_retry_then_one_replan():
+    run_ = build_run({"mission": "t", "tree": {"sequence": [{"grasp": {"object": "red cube"}}]}})
+    grasp_policy = next(n.parent for n, path in run_.compiled.nodes if path.endswith("grasp"))
+    assert grasp_policy.steps.retries == 1 and grasp_policy.steps.replan == 1
+    assert grasp_policy.replan_target is run_.compiled.root.decorated
+    no_retries = build_run({"mission": "t", "recovery": {"retries": 0}, "tree": {"grasp": {"object": "red cube"}}})
+    policy = next(n.parent for n, path in no_retries.compiled.nodes if path.endswith("grasp"))
+    assert policy.steps.retries == 0 and policy.replan_target is None, "mission-wide beats the skill's default"
+
+
+def test_an_alternative_runs_when_the_node_still_fails():
+    tree = {"sequence": [{**NEVER, "recovery": {"retries": 1, "alternative": {"say": {"text": "plan b"}}}}]}
+    s = run(tree)
+    assert s.result.tree_status == "SUCCESS" and s.result.said == ["plan b"]
+    assert len(events(s, "retry")) == 1, "the node's retries come before its alternative"
+    assert "SUCCESS" in s.statuses("sequence[0].check.alternative.say")
+
+
+def test_a_per_skill_alternative_is_compiled_wherever_the_skill_is_used():
+    tree = {"sequence": [NEVER, {"check": {"key": "also_never", "op": "exists"}}]}
+    s = run(tree, recovery={"skills": {"check": {"alternative": {"say": {"text": "instead"}}}}})
+    assert s.result.tree_status == "SUCCESS" and s.result.said == ["instead", "instead"]
+
+
+def test_a_failed_alternative_fails_the_node_with_its_reason():
+    tree = {"sequence": [{**NEVER, "recovery": {"alternative": {"check": {"key": "nope", "op": "exists"}}}}]}
+    s = run(tree)
+    assert s.result.tree_status == "FAILURE"
+    assert "nope" in s.result.cause
+
+
+def ask_run(tree, answers):
+    """Run with someone to ask, who gives ``answers`` in turn as each question comes."""
+    run_ = build_run({"mission": "t", "tree": tree})
+    said: list[str] = []
+    questions = Questions(said.append)
+    run_.context.questions = questions
+    run_.follow_with(run_.spec)  # compile again, with the question channel
+    replies = list(answers)
+
+    def answer() -> None:
+        if questions.awaiting and replies:
+            questions.answer(replies.pop(0))
+
+    run_.executor.observers.append(answer)
+    return Scenario(run_, run_.execute()), said
+
+
+def test_ask_tries_again_on_yes_and_fails_on_no():
+    tree = {"sequence": [{**NEVER, "recovery": {"retries": 1, "ask": True}}]}
+    s, said = ask_run(tree, ["maybe", "yes please", "no"])
+    assert s.result.tree_status == "FAILURE"
+    assert said[0] == "check failed: never is not on the blackboard. Shall I try again?"
+    assert said[1].startswith("Please answer yes or no.")
+    assert [e["message"] for e in events(s, "answer")] == ["told to try check again", "told not to try check again"]
+    assert len(events(s, "retry")) == 2, "yes gives the node its retries afresh"
+
+
+def test_ask_is_skipped_when_no_one_can_answer():
+    s = run({"sequence": [{**NEVER, "recovery": {"ask": True}}]})
+    assert s.result.tree_status == "FAILURE" and events(s, "ask") == []
+
+
+def test_a_stop_while_asking_withdraws_the_question():
+    tree = {"sequence": [{**NEVER, "recovery": {"ask": True}}]}
+    run_ = build_run({"mission": "t", "tree": tree})
+    questions = Questions(lambda text: None)
+    run_.context.questions = questions
+    run_.follow_with(run_.spec)
+    run_.executor.observers.append(lambda: questions.pending and run_.request_stop("stop (typed)"))
+    result = run_.execute()
+    assert result.safety.startswith("stop") and questions.pending is None
+
+
+@pytest.mark.parametrize(
+    ("reply", "answer"),
+    [("yes", Answer.YES), ("Sure, go ahead", Answer.YES), ("no thanks", Answer.NO), ("don't", Answer.NO)],
+)
+def test_yes_and_no(reply, answer):
+    assert read_answer(reply) is answer
+
+
+def test_neither_yes_nor_no():
+    assert read_answer("the blue one") is None
