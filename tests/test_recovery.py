@@ -8,6 +8,7 @@ from bt_humanoid.mission.compiler import resolve_recovery
 from bt_humanoid.testing.scenario import Scenario, build_run, run_scenario
 
 NEVER = {"check": {"key": "never", "op": "exists"}}  # a leaf that fails every time
+READY = {"check": {"key": "ready", "op": "exists"}}
 
 
 def run(tree, **header):
@@ -50,7 +51,7 @@ def test_replan_then_succeeds_when_the_world_changed():
             "policy": "all",
             "children": [
                 {"sequence": [{"wait": {"seconds": 1.2}}, {"set": {"key": "ready", "value": True}}]},
-                {"sequence": [{"wait": {"seconds": 0.1}}, {"check": {"key": "ready", "op": "exists"}, "recovery": {"replan": 3}}]},
+                {"sequence": [{"wait": {"seconds": 0.1}}, {**READY, "recovery": {"replan": 3}}]},
             ],
         }
     }

@@ -24,7 +24,6 @@ from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.robot import REST_SPEED, RobotController
 from bt_humanoid.perception.world_model import WorldModel
 
-
 OVERSPEED_TIME = 0.5  # s a joint must stay over its speed limit before the guard trips (a knock is shorter)
 
 
