@@ -34,7 +34,9 @@ def reference() -> str:
         params = ", ".join(p for p in (body if body != "—" else "", shape) if p)
         lines.append(f"| `{kind}` | {params} | {description} |")
     for name, info in sorted(REGISTRY.items()):
-        lines.append(f"| `{name}` (skill) | {_fields(info.params)} | {info.description} |")
+        recovery = ", ".join(f"{k} {v}" for k, v in info.recovery.items() if v)
+        default = f" (recovery by default: {recovery})" if recovery else ""
+        lines.append(f"| `{name}` (skill) | {_fields(info.params)} | {info.description}{default} |")
     for name, behavior in sorted(BehaviorLibrary().behaviors.items()):
         lines.append(f"| `{name}` (behaviour) | {_fields(behavior.args_model)} | {behavior.description} |")
     lines += ["", END]

@@ -13,6 +13,7 @@ def test_every_mission_has_a_scenario_test():
     tested = {"demo.yaml", "visit_kitchen.yaml", "language_tour.yaml"}
     tested |= {"pick_and_place.yaml", "pick_and_place_bottle.yaml", "pick_and_place_mug.yaml"}  # test_manipulation.py
     tested |= {"tour.yaml"}  # test_navigation.py
+    tested |= {"recovery.yaml"}  # test_recovery.py
     assert {p.name for p in MISSIONS.glob("*.yaml")} == tested
 
 

@@ -84,6 +84,7 @@ def test_a_branch_fault_fails_only_the_running_leaf_and_recovery_takes_over():
     result = run.execute()
     assert result.tree_status == "SUCCESS" and result.safety is None
     assert [e["message"] for e in events(result, "monitor")] == ["boom"]
+    assert result.summary()["halted_by"] == ["test: boom"], "the summary says which monitor halted what"
     assert "test: boom" in [e.get("feedback") for e in events(result, "status") if e["new"] == "FAILURE"]
     assert result.sim_time == pytest.approx(0.3 + 0.5 + 1.0, abs=0.11)
 

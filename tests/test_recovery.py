@@ -5,6 +5,7 @@ import pytest
 from bt_humanoid.engine.decorators import RecoverySteps
 from bt_humanoid.language.questions import Answer, Questions, read_answer
 from bt_humanoid.mission.compiler import resolve_recovery
+from bt_humanoid.paths import project_root
 from bt_humanoid.testing.scenario import Scenario, build_run, run_scenario
 
 NEVER = {"check": {"key": "never", "op": "exists"}}  # a leaf that fails every time
@@ -153,3 +154,16 @@ def test_yes_and_no(reply, answer):
 
 def test_neither_yes_nor_no():
     assert read_answer("the blue one") is None
+
+
+def test_the_recovery_example_compiles_as_written_and_runs(run_mission):
+    mission = project_root() / "missions" / "recovery.yaml"
+    policies = {path: node.parent for node, path in build_run(mission).compiled.nodes}
+    grasp = policies["sequence[3].sequence[2].grasp"]
+    assert (grasp.steps.retries, grasp.steps.replan, grasp.steps.ask) == (1, 1, True)
+    assert grasp.replan_target is policies["sequence[3].sequence"]
+    assert policies["sequence[1].move_base"].steps == RecoverySteps(retries=2, backoff=1.0)
+    assert "sequence[4].sequence[1].put.or_else" in policies, "the per-skill alternative of put"
+    scenario = run_mission(mission)
+    assert scenario.result.success, scenario.result.summary()
+    assert scenario.truth.rests_on("red cube", "table")

@@ -55,6 +55,11 @@ class RunResult:
     cause: str | None = None  # the last skill that failed and why, when the tree failed
 
     @property
+    def halted_by(self) -> list[str]:
+        """``monitor: message`` for every branch fault that halted a running leaf (recovery took it from there)."""
+        return [f"{e['monitor']}: {e['message']}" for e in self.events.events if e["event"] == "monitor"]
+
+    @property
     def success(self) -> bool:
         return self.tree_status == "SUCCESS" and all(c.holds for c in self.conditions)
 
@@ -69,6 +74,7 @@ class RunResult:
             "tree_status": self.tree_status,
             "conditions": [{"condition": c.condition, "holds": c.holds, "detail": c.detail} for c in self.conditions],
             "safety": self.safety,
+            "halted_by": self.halted_by,
             "cause": self.cause,
             "sim_time": round(self.sim_time, 3),
             "wall_time": round(self.wall_time, 3),

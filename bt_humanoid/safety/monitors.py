@@ -328,4 +328,6 @@ class SafetySupervisor:
         return self.violation
 
     def fault_for(self, leaf: object) -> Fault | None:
-        return next((fault for fault in self.faults if fault.concerns(leaf)), None)
+        """This tick's first fault that concerns ``leaf`` and that it does not handle itself."""
+        handled = getattr(leaf, "handles_faults", frozenset())
+        return next((f for f in self.faults if f.concerns(leaf) and f.monitor not in handled), None)

@@ -25,6 +25,8 @@ class Skill(py_trees.behaviour.Behaviour):
 
     Params: ClassVar[type[BaseModel]]
     skill_name: ClassVar[str] = ""
+    #: branch monitors whose faults this skill notices and handles itself (its guard leaves it running)
+    handles_faults: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(self, name: str, raw_params: dict[str, Any], context: SkillContext, path: str) -> None:
         super().__init__(name=name)

@@ -99,11 +99,11 @@ class StandNearParams(StrictModel):
 STANCE_ARRIVAL = 0.15  # m: the first and last stretch at a stance may graze the map's margin round furniture
 
 
-# a stance that cannot be reached may be reachable from a fresh look (the object seen anew, the way clear)
+# a stance not reached is tried once more (an arm settles, a passer-by moves on), then from a fresh look
 @skill(
     "stand_near",
     "drive (straight, short) to a stance from which one hand reaches an object or a surface spot",
-    recovery={"replan": 1},
+    recovery={"retries": 1, "replan": 1},
 )
 class StandNear(_ManipulationSkill):
     Params = StandNearParams
@@ -197,6 +197,7 @@ class GraspParams(StrictModel):
 )
 class Grasp(_ManipulationSkill):
     Params = GraspParams
+    handles_faults = frozenset({"dropped"})  # it verifies its hold after lifting and leaves the hand ready again
 
     @classmethod
     def check(cls, params: GraspParams, context: CheckContext) -> list[tuple[str, str]]:
