@@ -24,6 +24,7 @@ from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
 from bt_humanoid.language.questions import Questions
 from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.mission.schema import RecoverySettings
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.perception.grounding import resolve
 
@@ -134,6 +135,20 @@ def plan_command(
     return CommandOutcome(plan, spec)
 
 
+def ask_before_giving_up(spec: MissionSpec) -> MissionSpec:
+    """A planned mission, told to ask whether to try again when it has failed (someone is there to answer).
+
+    The question goes on the root, named after the command: "I could not bring me the coffee mug: …". Lower
+    nodes keep their own recovery; a safety stop is never asked about.
+    """
+    tree = spec.tree
+    if tree.recovery is None or tree.recovery.ask is None:
+        settings = tree.recovery.model_copy(update={"ask": True}) if tree.recovery else RecoverySettings(ask=True)
+        tree.recovery = settings
+    tree.name = tree.name or spec.header.mission
+    return spec
+
+
 class InteractiveSession:
     """Typed commands and answers, one after another, on one simulation: the robot keeps its place and belief.
 
@@ -190,7 +205,7 @@ class InteractiveSession:
             self.say(plan.say)
             return
         self.say(plan.say)
-        self.run.follow_with(outcome.spec)
+        self.run.follow_with(ask_before_giving_up(outcome.spec))
         result = self.run.execute(keep_open=True)
         self.results.append(result)
         if result.safety and result.safety.startswith("stop"):

@@ -122,7 +122,7 @@ def test_ask_tries_again_on_yes_and_fails_on_no():
     tree = {"sequence": [{**NEVER, "recovery": {"retries": 1, "ask": True}}]}
     s, said = ask_run(tree, ["maybe", "yes please", "no"])
     assert s.result.tree_status == "FAILURE"
-    assert said[0] == "check failed: never is not on the blackboard. Shall I try again?"
+    assert said[0] == "I could not check: never is not on the blackboard. Shall I try again?"
     assert said[1].startswith("Please answer yes or no.")
     assert [e["message"] for e in events(s, "answer")] == ["told to try check again", "told not to try check again"]
     assert len(events(s, "retry")) == 2, "yes gives the node its retries afresh"
@@ -167,3 +167,24 @@ def test_the_recovery_example_compiles_as_written_and_runs(run_mission):
     scenario = run_mission(mission)
     assert scenario.result.success, scenario.result.summary()
     assert scenario.truth.rests_on("red cube", "table")
+
+
+def test_an_interactive_session_routes_typed_lines_to_the_robots_question():
+    import queue
+
+    from bt_humanoid.commanding import InteractiveSession
+
+    lines: queue.Queue = queue.Queue()
+    said: list[str] = []
+    session = InteractiveSession("apartment", "wheeled_humanoid", lines, said.append)
+    session.questions.ask("I could not grasp: it slipped. Shall I try again?")
+    assert session.awaiting_answer
+    lines.put("yes")
+    session._listen_while_busy()  # what the executor calls between control steps
+    assert session.questions.take() is Answer.YES and not session.awaiting_answer
+    lines.put("say hello")
+    lines.put(None)
+    session.serve()
+    root = session.run.compiled.root.decorated
+    assert root.steps.ask and root.what == "say hello", "a planned command asks at its root before giving up"
+    assert "Done." in said

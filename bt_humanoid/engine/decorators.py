@@ -175,7 +175,7 @@ class RecoveryPolicy(py_trees.decorators.Decorator):
             return Status.FAILURE
         if self.steps.ask and self.questions is not None:
             self.asking = True
-            self.questions.ask(f"{self.what} failed: {reason}. Shall I try again?")
+            self.questions.ask(f"I could not {self.what}: {reason}. Shall I try again?")
             self._report("ask", f"asked whether to try {self.what} again")
             return Status.RUNNING
         return Status.FAILURE
