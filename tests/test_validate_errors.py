@@ -288,3 +288,10 @@ def test_a_move_to_a_spot_off_the_map_is_refused(tmp_path, capsys):
     )
     code, err = validate(capsys, path)
     assert code == 2 and "far.yaml:3" in err and "(50.0, 0.0) is outside the map: x -2 to 9" in err
+
+
+def test_an_unknown_parameter_is_refused_even_when_its_value_is_a_reference(tmp_path, capsys):
+    # found by the fuzzer: "$cube" is checked when the leaf starts, but only for a parameter the skill has
+    path = write(tmp_path, "m.yaml", "mission: x\ntree:\n  stand_near: {objekt: $cube}\n")
+    code, err = validate(capsys, path)
+    assert code == 2 and err.startswith("error: ") and err.endswith("m.yaml:3: stand_near: unknown parameter 'objekt'")

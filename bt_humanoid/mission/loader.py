@@ -45,7 +45,8 @@ def validate_params(model: type[BaseModel], raw: Any, source: YamlSource, path: 
         raw = {}
     if not isinstance(raw, dict):
         raise UserError(f"{prefix}parameters must be a mapping, got {type(raw).__name__}", where=source.where(path))
-    references = {key for key, value in raw.items() if is_reference(value)}
+    # a reference is checked when the leaf starts, but only for a parameter the skill has: an unknown name is wrong now
+    references = {key for key, value in raw.items() if is_reference(value) and key in model.model_fields}
     concrete = {key: value for key, value in raw.items() if key not in references}
     try:
         return model.model_validate(concrete)
