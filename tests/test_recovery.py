@@ -61,7 +61,7 @@ def test_replan_then_succeeds_when_the_world_changed():
     assert 1 <= len(events(s, "replan")) <= 3
 
 
-def test_the_skill_default_replans_and_the_mission_can_turn_it_off():
+def test_the_node_setting_wins_and_conditions_ignore_mission_wide_settings():
     tree = {"sequence": [{"say": {"text": "go"}}, {**NEVER, "recovery": {"replan": 1}}]}
     assert run(tree).result.said == ["go", "go"]
     off = run(tree, recovery={"skills": {"check": {"replan": 0}}})

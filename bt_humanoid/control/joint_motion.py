@@ -50,8 +50,7 @@ class JointReferenceController:
         self.acceleration = np.zeros(len(self.joints))
         self.goals: list[_Goal] = []
         # fingers squeeze what they hold by pressing past it: braking them to where they are would let go
-        fingers = [j for gripper in config.grippers.values() for j in gripper.joints]
-        self._arm_like = np.array([j not in fingers for j in self.joints])
+        self._arm_like = np.array([j not in config.finger_joints for j in self.joints])
 
     def indices(self, joints: list[str]) -> np.ndarray:
         return np.array([self.io.index(j) for j in joints], dtype=int)

@@ -126,10 +126,12 @@ class RecoveryPolicy(py_trees.decorators.Decorator):
             self.initialise()
         if self.asking:
             answer = self._answer()
-            if answer is not Answer.YES:  # no answer yet, or no
-                self.status = Status.RUNNING if answer is None else Status.FAILURE
-                if answer is Answer.NO:
-                    self.stop(Status.FAILURE)
+            if answer is None:
+                self.status = Status.RUNNING
+                yield self
+                return
+            if answer is Answer.NO:
+                self.stop(Status.FAILURE)
                 yield self
                 return
         if self.resume_at is not None and self.clock() < self.resume_at:

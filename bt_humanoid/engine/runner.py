@@ -142,20 +142,18 @@ class MissionRun:
         self.stop_monitor = StopRequestMonitor()
         self.time_budget = safety.time_budget or defaults.time_budget
         margin = safety.joint_limit_margin if safety.joint_limit_margin is not None else defaults.joint_limit_margin
-        config = spec.known.robot_config
-        speed_limits = [
-            config.motion_limits(j).velocity * defaults.joint_speed_factor for j in self.robot.body_io.joints
-        ]
+        io = self.robot.body_io
+        limbs = [io.actuator(j) for j in io.joints if j not in spec.known.robot_config.finger_joints]
         monitors = [
             self.stop_monitor,
             BumperMonitor(self.sim.model, self.sim.data, self._trunk(), self.sim.robot_bodies),  # a cause first
-            JointLimitMonitor(self.robot, margin, np.array(speed_limits)),
+            JointLimitMonitor(self.robot, margin, defaults.joint_speed_factor),
             TimeBudgetMonitor(self.time_budget, self.sim.time),
             WorkspaceMonitor(self.robot, np.array(spec.known.world.bounds), defaults.min_hand_height),
         ]
         branch_monitors = [
             DroppedMonitor(self.robot.grippers, lambda: self.context.world_model),
-            StrainMonitor(self.sim.model, self.sim.data, self._limb_actuators(), defaults.strain_time),
+            StrainMonitor(self.sim.model, self.sim.data, limbs, defaults.strain_time),  # not wheels, not fingers
             StuckMonitor(self.robot, lambda: self.executor.running, defaults.stuck_after),
         ]
         self.supervisor = SafetySupervisor(monitors, lambda: self.sim.time, branch_monitors)
@@ -197,21 +195,10 @@ class MissionRun:
         self.robot.monitor_separation(separation)
         return separation
 
-    def _limb_actuators(self) -> list[int]:
-        """Actuators of the arms, waist, lift and head: what the strain monitor watches (not wheels or fingers)."""
-        config, model = self.context.robot_config, self.sim.model
-        fingers = {j for g in config.grippers.values() for j in g.joints}
-        joints = [j for j in self.robot.body_io.joints if j not in fingers]
-        return [
-            a
-            for a in range(model.nu)
-            if model.actuator_trntype[a] == 0 and model.joint(model.actuator_trnid[a, 0]).name in joints
-        ]
-
     def _trunk(self) -> set[int]:
         """The robot's bodies that are not on an arm: what the bumper monitor watches."""
         model = self.sim.model
-        hands = [int(model.jnt_bodyid[model.joint(j).id]) for g in self.sim.robot.grippers.values() for j in g.joints]
+        hands = [int(model.jnt_bodyid[model.joint(j).id]) for j in self.sim.robot.finger_joints]
         return trunk_bodies(model, self.sim.robot_bodies, hands) if hands else set()
 
     def follow_with(self, spec: MissionSpec) -> None:

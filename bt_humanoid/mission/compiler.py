@@ -10,7 +10,7 @@ robot's defaults, in that order.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import py_trees
@@ -51,10 +51,12 @@ def _label(node: NodeSpec) -> str:
 
 def resolve_recovery(*layers: Mapping[str, Any]) -> RecoverySteps:
     """Each field from the first layer that sets it (layers: most specific first); unset fields keep defaults."""
-    fields = {}
-    for name in ("retries", "backoff", "replan", "ask"):
-        fields[name] = next((layer[name] for layer in layers if layer.get(name) is not None), None)
-    return RecoverySteps(**{k: v for k, v in fields.items() if v is not None})
+    found = {}
+    for name in (f.name for f in fields(RecoverySteps)):
+        value = next((layer[name] for layer in layers if layer.get(name) is not None), None)
+        if value is not None:
+            found[name] = value
+    return RecoverySteps(**found)
 
 
 class Compiler:
@@ -98,19 +100,10 @@ class Compiler:
         return None
 
     def _policy(self, child: Behaviour, steps: RecoverySteps, what: str) -> RecoveryPolicy:
-        policy = RecoveryPolicy(
-            RECOVERY_NAME,
-            child,
-            steps,
-            self.context.clock,
-            self.supervisor,
-            self.context.questions,
-            self.on_recovery,
-            what,
+        context = self.context
+        return RecoveryPolicy(
+            RECOVERY_NAME, child, steps, context.clock, self.supervisor, context.questions, self.on_recovery, what
         )
-        if steps.replan:
-            self.awaiting_target.append(policy)
-        return policy
 
     def _wrapped(self, node: NodeSpec) -> Behaviour:
         waiting = len(self.awaiting_target)
@@ -139,11 +132,10 @@ class Compiler:
         if isinstance(inner, py_trees.composites.Sequence) and node.category != "behavior":
             # a sequence starts over for the nodes below it that replan (up to the next sequence down)
             for below in self.awaiting_target[waiting:]:
-                if below is not policy:
-                    below.replan_target = policy
+                below.replan_target = policy
             del self.awaiting_target[waiting:]
-            if steps.replan:
-                self.awaiting_target.append(policy)
+        if steps.replan:
+            self.awaiting_target.append(policy)
         return SafetyGuard(GUARD_NAME, policy, self.supervisor, leaf=node.category == "skill" and alternative is None)
 
     def _build(self, node: NodeSpec) -> Behaviour:

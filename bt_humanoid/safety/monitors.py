@@ -77,19 +77,20 @@ class StopRequestMonitor:
 class JointLimitMonitor:
     """Fires when a joint is past its MJCF range by more than the margin, or faster than its speed limit.
 
-    ``speed_limits`` (rad/s or m/s per joint, already with any allowance) catch a controller gone wrong: the
-    trajectories never ask for more than the robot.yaml limits. A joint must stay over its limit for
+    ``speed_factor`` times the joints' velocity limits (robot.yaml) catches a controller gone wrong: the
+    trajectories never ask for more than those limits. A joint must stay over its limit for
     ``OVERSPEED_TIME``: a knock (the base bumping into something) swings a wrist fast for an instant.
     """
 
     name = "joint_limits"
 
-    def __init__(self, robot: RobotController, margin: float, speed_limits: np.ndarray | None = None) -> None:
+    def __init__(self, robot: RobotController, margin: float, speed_factor: float = np.inf) -> None:
         io = robot.body_io
         self.io = io
         self.lower = np.where(io.limited, io.lower - margin, -np.inf)
         self.upper = np.where(io.limited, io.upper + margin, np.inf)
-        self.speed_limits = speed_limits if speed_limits is not None else np.full(len(io.joints), np.inf)
+        velocity_limits = robot.joints.limits[0]  # per joint of io, the order the joint controller keeps
+        self.speed_limits = velocity_limits * speed_factor
         self.fast_since = np.full(len(io.joints), np.inf)
 
     def check(self, now: float) -> str | None:

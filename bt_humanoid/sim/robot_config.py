@@ -124,11 +124,14 @@ class RobotConfig(StrictModel):
         return next((j for j in self.groups.get("head", []) if "tilt" in j), None)
 
     @property
+    def finger_joints(self) -> list[str]:
+        """The grippers' finger joints (they press on what they hold by design)."""
+        return [j for g in self.grippers.values() for j in g.joints]
+
+    @property
     def actuated_joints(self) -> list[str]:
         """Every position-controlled joint: groups first, then gripper fingers."""
-        joints = [j for group in self.groups.values() for j in group]
-        joints += [j for g in self.grippers.values() for j in g.joints]
-        return joints
+        return [j for group in self.groups.values() for j in group] + self.finger_joints
 
 
 def load_robot_config(name: str) -> RobotConfig:
