@@ -49,6 +49,7 @@ class JointReferenceController:
         self.velocity = np.zeros(len(self.joints))
         self.acceleration = np.zeros(len(self.joints))
         self.goals: list[_Goal] = []
+        self.feedforward = np.zeros(len(self.joints))  # rad (m) added to the targets sent (inertial_feedforward)
         # fingers squeeze what they hold by pressing past it: braking them to where they are would let go
         self._arm_like = np.array([j not in config.finger_joints for j in self.joints])
 
@@ -114,7 +115,7 @@ class JointReferenceController:
             self.velocity[goal.joints] = 0.0
             self.acceleration[goal.joints] = 0.0
             self._finish(goal, measured, elapsed)
-        self.io.command(self.actuators, self.position)
+        self.io.command(self.actuators, self.position + self.feedforward)
 
     def _finish(self, goal: _Goal, measured: np.ndarray, elapsed: float) -> None:
         if goal.target is None or not goal.settle_check:

@@ -13,6 +13,7 @@ import numpy as np
 
 from bt_humanoid.control.base_driver import BaseDriver, SpeedLimiter
 from bt_humanoid.control.gripper import GripperController
+from bt_humanoid.control.inertial_feedforward import BaseAccelerationFeedforward
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.whole_body import WholeBodyController
 from bt_humanoid.sim.robot_config import RobotConfig
@@ -49,6 +50,7 @@ class RobotController:
         io = self.body_io
         ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
         self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
+        self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, base_joints)
         self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
         self.separation: Separation | None = None  # set with monitor_separation()
         self.control_period = 0.01  # s between step() calls; the executor sets it
@@ -70,6 +72,9 @@ class RobotController:
             planner.step()
         self.whole_body.step()  # streams references first, the controllers below then track them
         self.base.step()
+        self.joints.feedforward = self.feedforward.update(
+            self.base.pose(), self.body_io.positions(), self.base.acceleration
+        )
         self.joints.step()
         self.grippers.step()
 

@@ -7,6 +7,7 @@ state directly, so the same controllers could drive other hardware.
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 
 from bt_humanoid.sim.simulation import Simulation
@@ -37,6 +38,23 @@ class MujocoRobotIO:
 
     def actuator(self, joint: str) -> int:
         return self.sim.actuator_for_joint(joint)
+
+    def velocity_lag(self, joint: str) -> float:
+        """Time constant (s) of a joint's velocity actuator: its inertia now over the actuator's gain.
+
+        A velocity actuator pushes with ``kv × (commanded − actual velocity)``, so the joint follows a
+        commanded velocity one time constant late; a controller leads its command by this much acceleration.
+        """
+        model = self.sim.model
+        inertia = np.zeros((model.nv, model.nv))
+        mujoco.mj_fullM(model, self.sim.data, inertia)
+        dof = model.joint(joint).dofadr[0]
+        return float(inertia[dof, dof] / self.gain(joint))
+
+    def gain(self, joint: str) -> float:
+        """The gain of a joint's actuator: N·m (N) per radian (metre) of position error for a position actuator,
+        per rad/s (m/s) of velocity error for a velocity actuator."""
+        return float(self.sim.model.actuator_gainprm[self.actuator(joint), 0])
 
     def command(self, actuators: np.ndarray, values: np.ndarray) -> None:
         self.sim.data.ctrl[actuators] = values

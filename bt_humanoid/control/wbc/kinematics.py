@@ -85,6 +85,12 @@ class RobotKinematics:
         pin.updateFramePlacements(self.model, self.data)
         self._jacobians.clear()
 
+    def mass_matrix(self) -> np.ndarray:
+        """Joint-space inertia (n × n over the controlled joints) at the positions last set by update()."""
+        full = pin.crba(self.model, self.data, self.q)
+        full = np.triu(full) + np.triu(full, 1).T  # Pinocchio fills the upper triangle only
+        return full[np.ix_(self._v_index, self._v_index)]
+
     def frame_id(self, frame: str) -> int:
         if frame not in self._frame_ids:
             if not self.model.existFrame(frame):
