@@ -1,5 +1,7 @@
 """Safety guards: a stop request, joint limits, the time budget and the bumper halt the tree; the robot rests."""
 
+import numpy as np
+import pytest
 from py_trees.common import Status
 
 from bt_humanoid.sim.ground_truth import GroundTruth
@@ -31,6 +33,36 @@ def test_stop_request_mid_motion_halts_and_brakes():
     assert "there" not in run.said
     halted = [e for e in run.events.events if e["event"] == "status" and e["new"] == "INVALID"]
     assert any(e["node"].endswith("move_base") for e in halted)
+
+
+@pytest.mark.parametrize("held", [True, False], ids=["feedforward", "without"])
+def test_the_upper_body_is_held_still_while_the_base_brakes(held):
+    """The base's deceleration deflects soft joints (head, shoulders); the inertial feedforward cancels it."""
+    run = build_run(DRIVE)
+    executor, robot = run.executor, run.robot
+    if not held:
+        robot.feedforward.update = lambda *_: np.zeros(len(robot.body_io.joints))
+    while run.sim.time < 1.5:
+        executor.tick()
+        executor.advance()
+    assert np.hypot(*robot.base.speeds()[:2]) > 0.5  # driving fast
+    arms_and_head = np.array([j not in robot.config.finger_joints for j in robot.body_io.joints])
+    deflection: list[float] = []
+    executor.observers.append(
+        lambda: deflection.append(
+            float(np.max(np.abs(robot.body_io.positions() - robot.joints.position)[arms_and_head]))
+        )
+    )
+    run.request_stop("test stop")
+    executor.tick()
+    stopped = run.sim.time
+    executor.halt()
+    assert robot.at_rest()
+    if held:
+        assert max(deflection) < 0.002  # rad
+        assert run.sim.time - stopped < 0.35  # s, from full speed: 3.2 m/s² and no swinging back
+    else:
+        assert max(deflection) > 0.004
 
 
 def test_time_budget_ends_a_long_mission():
