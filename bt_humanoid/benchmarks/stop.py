@@ -18,10 +18,12 @@ from __future__ import annotations
 import statistics
 import time
 
+import mujoco
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
 from bt_humanoid.commanding import context_at_start
+from bt_humanoid.control.base_driver import BRAKE_ACCEL
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.language.asr import CommandRecognizer
 from bt_humanoid.language.audio import RATE, spoken, with_noise
@@ -29,6 +31,7 @@ from bt_humanoid.language.embedded import EmbeddedPlanner, is_stop
 from bt_humanoid.language.listening import Listener
 from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.sim.simulation import Simulation
 
 COMMANDS = (  # from the start pose; walking straight ahead would meet the storage box (move_base does not steer)
     "go to the kitchen",
@@ -41,6 +44,35 @@ VOICES = ("en-us", "en-gb")
 SNR_DB = 20.0
 MOVING = 0.05  # m/s (or rad/s): the robot counts as in motion above this
 EARLIEST = 1.0  # s of simulation before a stop may come
+
+
+def braking_margin(world: str, robot: str) -> dict[str, float]:
+    """How hard the base brakes against the deceleration that would tip the robot forward on a real floor.
+
+    The base here slides on joints and cannot tip, so this is checked from the model instead: at its start
+    posture the robot tips over the front edge of its base (the narrowest cylinder of the base body, its
+    support) when deceleration × height of the centre of mass exceeds g × the centre's distance to that edge.
+    """
+    sim = Simulation.load(world, robot)
+    model, data = sim.model, sim.data
+    mujoco.mj_forward(model, data)
+    base = int(model.body_rootid[model.joint(sim.robot.base.joints["x"]).bodyid[0]])
+    cylinder = mujoco.mjtGeom.mjGEOM_CYLINDER
+    radii = [
+        model.geom_size[g][0]
+        for g in range(model.ngeom)
+        if model.geom_bodyid[g] == base and model.geom_type[g] == cylinder
+    ]
+    support = float(min(radii))
+    centre = data.xmat[base].reshape(3, 3).T @ (data.subtree_com[base] - data.xpos[base])  # in the base's frame
+    return {
+        "brake_accel": BRAKE_ACCEL * sim.robot.base.limits.max_accel,
+        "tip_accel": 9.81 * (support - float(centre[0])) / float(centre[2]),
+        "mass": float(model.body_subtreemass[base]),
+        "com_height": float(centre[2]),
+        "com_ahead": float(centre[0]),
+        "support_radius": support,
+    }
 
 
 class SpokenStop:
@@ -110,6 +142,12 @@ def main(argv: list[str] | None = None) -> int:
     recognizer = CommandRecognizer(context.world) if args.spoken else None
     how = "spoken" if args.spoken else "typed"
     print(f"bt-humanoid stop benchmark: {args.trials} {how} stops in mid-motion, seed {args.seed} (one core)")
+    margin = braking_margin("apartment", "wheeled_humanoid")
+    print(
+        f"  the base brakes at {margin['brake_accel']:.1f} m/s²; the robot would tip forward at "
+        f"{margin['tip_accel']:.1f} m/s² ({margin['mass']:.0f} kg, centre of mass {margin['com_height']:.2f} m up and "
+        f"{margin['com_ahead']:.2f} m ahead of the base centre, support radius {margin['support_radius']:.2f} m)"
+    )
     started = time.perf_counter()
     latencies: list[float] = []
     speeds: list[float] = []
@@ -143,6 +181,7 @@ def main(argv: list[str] | None = None) -> int:
         "latency_max_ms": max(latencies) * 1000 if latencies else None,
         "speed_at_stop_median": statistics.median(speeds) if speeds else None,
         "spotting_median_ms": statistics.median(spotting) * 1000 if args.spoken and spotting else None,
+        **{f"braking_{key}": round(value, 3) for key, value in margin.items()},
         "wall_s": round(time.perf_counter() - started, 1),
     }
     print()

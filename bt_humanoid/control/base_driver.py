@@ -25,7 +25,7 @@ SETTLE_TIMEOUT = 2.0  # s after the plan ends before a goal that has not arrived
 
 # Braking is an emergency stop, not a smooth one: 4 × 0.8 m/s² = 3.2 m/s², reached in 50 ms. The robot (72 kg,
 # centre of mass 0.42 m up and 6 cm ahead of the base centre, on a 0.3 m base) would tip forward at about
-# 5.6 m/s² on a real floor; the actuators could give 11 m/s².
+# 5.7 m/s² on a real floor (benchmarks/stop.py braking_margin); the actuators could give 800 N / 72 kg = 11 m/s².
 BRAKE_ACCEL = 4.0  # × the base's acceleration limits when braking
 BRAKE_JERK = 20.0  # × its jerk limits when braking
 

@@ -34,7 +34,7 @@ class BaseAccelerationFeedforward:
         if not np.any(base_acceleration):
             self.offsets[:] = 0.0
             return self.offsets
-        self.kinematics.update(np.concatenate([base_pose, body_positions[self.joints]]))
-        coupling = self.kinematics.mass_matrix()[3:, :3]
+        inertia = self.kinematics.mass_matrix(np.concatenate([base_pose, body_positions[self.joints]]))
+        coupling = inertia[3:, :3]
         self.offsets[self.joints] = coupling @ base_acceleration / self.gains
         return self.offsets

@@ -66,15 +66,14 @@ class RobotController:
         self.base.limiter = separation
 
     def step(self) -> None:
+        base_pose = self.base.pose()  # the encoders of this instant: nothing moves until the physics steps
         if self.separation is not None:
-            self.separation.update(self.base.pose()[:2])
+            self.separation.update(base_pose[:2])
         for planner in self.planners:
             planner.step()
         self.whole_body.step()  # streams references first, the controllers below then track them
         self.base.step()
-        self.joints.feedforward = self.feedforward.update(
-            self.base.pose(), self.body_io.positions(), self.base.acceleration
-        )
+        self.joints.feedforward = self.feedforward.update(base_pose, self.body_io.positions(), self.base.acceleration)
         self.joints.step()
         self.grippers.step()
 

@@ -56,7 +56,8 @@ class RunResult:
 
     @property
     def halted_by(self) -> list[str]:
-        """``monitor: message`` for every branch fault that halted a running leaf (recovery took it from there)."""
+        """``monitor: message`` for every branch fault reported: it halted the running leaf it concerned (whose
+        recovery took over), unless that leaf handles such faults itself (grasp checks its own hold)."""
         return [f"{e['monitor']}: {e['message']}" for e in self.events.events if e["event"] == "monitor"]
 
     @property

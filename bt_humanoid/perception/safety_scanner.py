@@ -25,8 +25,7 @@ class SafetyScanner:
         self.model, self.data = model, data
         self.base_body = base_body
         self.config = config
-        angles = np.linspace(0.0, 2 * math.pi, config.rays, endpoint=False)
-        self._angles = angles
+        self._angles = np.linspace(0.0, 2 * math.pi, config.rays, endpoint=False)
         self._geom_ids = np.zeros(config.rays, dtype=np.int32)
         self._distances = np.zeros(config.rays)
         self.period = 1.0 / config.rate_hz

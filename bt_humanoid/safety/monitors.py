@@ -217,8 +217,8 @@ class DroppedMonitor:
     """Fires when a hand the robot believes holds something has shut on nothing: the object was dropped.
 
     The fingers are the sensor: what they hold keeps them apart (a hand lets go only after the belief says
-    so). The belief is corrected at
-    once (the object is no longer held; where it fell is unknown until it is seen), so it fires once per drop.
+    so). The belief is corrected at once (the object is no longer held; where it fell is unknown until it is
+    seen), so it fires once per drop.
     """
 
     name = "dropped"

@@ -79,14 +79,18 @@ class RobotKinematics:
 
     def update(self, positions: np.ndarray) -> None:
         """Set the controlled joints (other joints stay at their last value) and recompute kinematics."""
-        self.positions = np.array(positions, dtype=float)
-        self.q[self._q_index] = self.positions
+        self._set(positions)
         pin.computeJointJacobians(self.model, self.data, self.q)
         pin.updateFramePlacements(self.model, self.data)
         self._jacobians.clear()
 
-    def mass_matrix(self) -> np.ndarray:
-        """Joint-space inertia (n × n over the controlled joints) at the positions last set by update()."""
+    def _set(self, positions: np.ndarray) -> None:
+        self.positions = np.array(positions, dtype=float)
+        self.q[self._q_index] = self.positions
+
+    def mass_matrix(self, positions: np.ndarray) -> np.ndarray:
+        """Joint-space inertia (n × n over the controlled joints) at ``positions`` (no Jacobians: dynamics only)."""
+        self._set(positions)
         full = pin.crba(self.model, self.data, self.q)
         full = np.triu(full) + np.triu(full, 1).T  # Pinocchio fills the upper triangle only
         return full[np.ix_(self._v_index, self._v_index)]
