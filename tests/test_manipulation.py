@@ -132,6 +132,26 @@ def test_fetch_carries_the_mug_from_the_counter_to_the_shelf():
     assert scenario.truth.upright("coffee mug")
 
 
+def test_grasp_moves_a_hand_that_hides_the_object_before_it_looks():
+    mug = (8.3, 2.0, 0.945)  # where the world file puts it
+    mission = {
+        "mission": "grasp the mug with the hand in the way",
+        "tree": {
+            "sequence": [
+                {"stand_near": {"object": "coffee mug"}},
+                {"reach": {"position": [mug[0] - 0.03, mug[1], mug[2] + 0.12], "yaw": 90}},  # between eye and mug
+                {"grasp": {"object": "coffee mug"}},
+            ]
+        },
+    }
+    run = build_run(mission, robot_start=(7.4, 2.0, 0.0))
+    scenario = Scenario(run, run.execute())
+    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    grasp = [e.get("feedback", "") for e in scenario.events if e.get("node", "").endswith("grasp")]
+    assert any(f.startswith("clear the view: reaching") for f in grasp), grasp
+    assert scenario.truth.in_hand("coffee mug")
+
+
 def _give(release_after: float | None, timeout: float) -> tuple[Scenario, list[float]]:
     give = {"give": {"to": "person", "timeout": timeout}}
     if release_after is not None:

@@ -4,6 +4,8 @@ import numpy as np
 import pytest
 
 from bt_humanoid.perception.detector import colour_name, detect
+from bt_humanoid.perception.fusion import integrate
+from bt_humanoid.perception.perceiver import MASKED_DEPTH
 from bt_humanoid.perception.rgbd_camera import RgbdCamera
 from bt_humanoid.testing.scenario import build_run
 
@@ -63,6 +65,42 @@ def test_the_mug_on_the_counter_and_the_ball_on_the_shelf():
 )
 def test_colour_names(rgb, name):
     assert colour_name(np.array(rgb)) == name
+
+
+def _hide_left_half_of_the_mug(run, frame) -> None:
+    """Cover the left half of the mug's pixels as the robot's arm would (masked out as the robot's own)."""
+    mug = run.truth.object_centre("coffee mug")
+    near = np.linalg.norm(frame.points()[..., :2] - mug[:2], axis=-1) < 0.05
+    rows, cols = np.nonzero(near & (frame.points()[..., 2] > 0.91))
+    cut = cols < np.median(cols)
+    frame.hidden = np.zeros(frame.depth.shape, dtype=bool)
+    frame.hidden[rows[cut], cols[cut]] = True
+    frame.depth[frame.hidden] = MASKED_DEPTH
+
+
+def test_a_detection_cut_off_by_the_robots_own_arm_is_marked_occluded():
+    run, frame, found = _look((7.4, 2.0, 0.0))
+    assert not next(d for d in found if d.surface == "counter").occluded
+    _hide_left_half_of_the_mug(run, frame)
+    (mug,) = [d for d in detect(frame, list(run.context.world_model.surfaces.values())) if d.surface == "counter"]
+    assert mug.occluded
+
+
+def test_an_occluded_view_neither_moves_an_object_nor_counts_against_it():
+    run, frame, found = _look((7.4, 2.0, 0.0))
+    belief = run.context.world_model
+    integrate(belief, found, frame)
+    mug = next(o for o in belief.objects.values() if o.kind == "mug")
+    position, yaw, confidence = mug.position.copy(), mug.yaw, mug.confidence
+    _hide_left_half_of_the_mug(run, frame)
+    integrate(belief, detect(frame, list(belief.surfaces.values())), frame)
+    assert np.array_equal(mug.position, position) and mug.yaw == yaw  # the cut-off part says nothing of its pose
+    assert mug.confidence > confidence  # but it is still there
+    frame.hidden[:] = True  # the arm covers the whole view: nothing seen, nothing lost
+    frame.depth[:] = MASKED_DEPTH
+    before = mug.confidence
+    integrate(belief, detect(frame, list(belief.surfaces.values())), frame)
+    assert mug.confidence == before
 
 
 def _camera_run(robot_start, tree=None):

@@ -43,6 +43,7 @@ RESTS = 0.15  # relative error allowed in a ball's resting pose: centre one radi
 BOX_FLATNESS = 0.3  # share of a thing's visible points on its flat top above which it is a box (a lid faces up)
 LID_WIDTH = 0.6  # share of a thing's width a flat top must span to be its lid
 HANDLE_VIEW = 100  # points of a round thing from which a lump sticking out of it is taken for a handle
+OCCLUSION_BORDER = 3  # pixels: a region this close to the robot's own body in the image may be cut off by it
 WELL_SEEN_TOP = 40  # points on a flat top from which its outline tells a square from a disc
 
 
@@ -56,6 +57,7 @@ class Detection:
     surface: str
     pixels: int
     yaw_known: bool = True  # false for a mug whose handle was not seen (its yaw is a guess)
+    occluded: bool = False  # partly hidden behind the robot's own arm: what shows is a cut-off part of it
 
 
 def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
@@ -73,6 +75,7 @@ def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
     edges = _depth_edges(frame.depth)
     count, labels, stats, _ = cv2.connectedComponentsWithStats((candidate & ~edges).astype(np.uint8), connectivity=4)
     labels = _reattach(labels, candidate & edges, frame.depth)
+    beside_robot = _beside(frame.hidden)
     detections = []
     for label in range(1, count):
         if stats[label, cv2.CC_STAT_AREA] < MIN_PIXELS:
@@ -81,8 +84,17 @@ def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
         surface = surfaces[int(np.bincount(surface_of[rows, cols]).argmax())]
         detection = _describe(points[rows, cols], frame.rgb[rows, cols], surface, frame.position)
         if detection is not None:
+            detection.occluded = bool(beside_robot is not None and beside_robot[rows, cols].any())
             detections.append(detection)
     return _without_fragments(detections)
+
+
+def _beside(hidden: np.ndarray | None) -> np.ndarray | None:
+    """Pixels within ``OCCLUSION_BORDER`` of the robot's own body in the image (None: nothing of it in view)."""
+    if hidden is None or not hidden.any():
+        return None
+    size = 2 * OCCLUSION_BORDER + 1
+    return cv2.dilate(hidden.astype(np.uint8), np.ones((size, size), np.uint8)).astype(bool)
 
 
 def _without_fragments(detections: list[Detection]) -> list[Detection]:

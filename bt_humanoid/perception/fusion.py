@@ -6,7 +6,10 @@ adding a vote for its kind and colour: one view may take a mug with its
 handle hidden for a can, the next view sees the handle, and the votes
 settle it. A detection near no tracked object starts a new one. A tracked
 object that should be in view (inside the image, in range, nothing nearer
-in front of it) but is not seen loses confidence; at zero it is gone.
+in front of it, not behind the robot's own arm) but is not seen loses
+confidence; at zero it is gone. A detection cut off by the robot's own arm
+confirms the object it belongs to but says nothing of its shape or pose:
+the visible part's centre is off, and its cut edge can look like a handle.
 """
 
 from __future__ import annotations
@@ -32,8 +35,13 @@ def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame)
     seen: set[str] = set()
     for detection in detections:
         tracked = _nearest(belief, detection)
+        if tracked is None and detection.occluded:
+            continue  # a part of something: a later, clear view will say what and where
         if tracked is None:
             tracked = _new(belief, detection, frame.time)
+        elif detection.occluded:
+            tracked.confidence = min(1.0, tracked.confidence + GAIN)
+            tracked.last_seen = frame.time
         else:
             _update(tracked, detection, frame.time)
         seen.add(tracked.id)
@@ -129,4 +137,6 @@ def _should_be_visible(tracked: TrackedObject, frame: RgbdFrame) -> bool:
     height, width = frame.depth.shape
     if not (BORDER <= row < height - BORDER and BORDER <= col < width - BORDER):
         return False
+    if frame.is_hidden(row, col):
+        return False  # behind the robot's own arm
     return bool(frame.depth[row, col] > distance - 0.05)  # nothing nearer in front of it

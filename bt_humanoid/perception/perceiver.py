@@ -82,3 +82,4 @@ class Perceiver:
         is_geom = segmentation[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
         robot = is_geom & self._robot_geoms[np.clip(geom, 0, len(self._robot_geoms) - 1)]
         frame.depth[robot] = MASKED_DEPTH
+        frame.hidden = robot

@@ -28,6 +28,11 @@ class RgbdFrame:
     position: np.ndarray  # camera origin, world (3,)
     rotation: np.ndarray  # camera axes in the world (3, 3): x right, y up, looking along -z
     time: float
+    hidden: np.ndarray | None = None  # (H, W) bool: pixels where the robot's own body blocks the view
+
+    def is_hidden(self, row: int, col: int) -> bool:
+        """Whether the robot's own body covers this pixel (what lies behind it is unknown, not absent)."""
+        return self.hidden is not None and bool(self.hidden[row, col])
 
     def points(self, rows: np.ndarray | None = None, cols: np.ndarray | None = None) -> np.ndarray:
         """World points of pixels (all of them, as (H, W, 3), or the given ones, as (N, 3))."""

@@ -38,6 +38,7 @@ CARRY_SIDE = 0.25  # m to the side of the working hand: outside the shoulder
 CARRY_HEIGHT = 0.95  # m above the floor, at least
 MAX_CARRY_HEIGHT = 1.2  # m: the arm's comfortable limit (torso lifted)
 CARRY_TOLERANCE = (0.03, 0.2)  # m, rad: the carry pose needs no precision
+IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (or nearer) hides part of it
 
 
 class _ManipulationSkill(PhasedSkill):
@@ -205,6 +206,7 @@ class Grasp(_ManipulationSkill):
 
     def phases(self):
         return [
+            ("clear the view", self._clear_view),
             ("plan", self._plan),
             ("raise", self._raise),
             ("pre-grasp", self._pre_grasp),
@@ -215,6 +217,27 @@ class Grasp(_ManipulationSkill):
             ("verify", self._verify),
             ("carry", lambda: self._carry(self.params.side, [self._clearance(self.params.side, self.surface, 0.0)])),
         ]
+
+    def _clear_view(self) -> MotionHandle | None:
+        """Move the empty hand out of the camera's line of sight to the object before the close look.
+
+        A hand over the object (after a failed attempt) or beside it (the ready posture) hides part of it: the
+        rest reads as a smaller thing off-centre, and the cut edge can pass for a mug's handle.
+        """
+        side = self.params.side
+        if self.context.perceiver is None or self.context.world_model.held(side) is not None:
+            return None
+        target = self._object(self.params.object)
+        whole_body = self.context.robot.whole_body
+        eye = whole_body.frame_pose(self.context.robot_config.frames["head_camera"][1]).translation
+        to_hand = whole_body.frame_pose(whole_body.hand_frame(side)).translation - eye
+        to_object = target.position - eye
+        cosine = float(to_hand @ to_object) / max(float(np.linalg.norm(to_hand) * np.linalg.norm(to_object)), 1e-9)
+        if cosine < math.cos(IN_THE_WAY) or np.linalg.norm(to_hand) > np.linalg.norm(to_object) + 0.1:
+            return None
+        surface = self.context.world_model.surface_under(target.position)
+        clearances = [self._clearance(side, surface, 0.0)] if surface is not None else []
+        return self._carry(side, clearances)
 
     def _plan(self) -> None:
         side = self.params.side
