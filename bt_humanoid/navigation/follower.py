@@ -28,6 +28,7 @@ BLOCKED_ERROR = 0.25  # m behind the reference: something holds the base back
 SETTLE_TIMEOUT = 3.0  # s at the end of the route to come within tolerance
 END_EPSILON = 1e-3  # m of the route's end that counts as reached
 STOP_SHORT = 0.3  # m the base stops short of where its route is blocked
+HORIZON = 60.0  # s of travel at the allowed speed that the route timing looks ahead (a crawl: a few cm)
 
 
 class RouteFollower:
@@ -106,9 +107,16 @@ class RouteFollower:
         inp.max_velocity = [max(speed_cap, 1e-3), max(share * limits.max_yaw_rate, 1e-3)]
         yaw = self._heading_target(route, s, index)
         end = route.length if self.stop_at is None else min(route.length, max(s, self.stop_at - STOP_SHORT))
+        # while held to a crawl (someone close), a far end would take longer than a trajectory can last: aim no
+        # further than the crawl covers in HORIZON seconds, beyond the braking distance (re-aimed every step)
+        speed = float(inp.current_velocity[0])
+        end = min(end, s + speed**2 / (2 * limits.max_accel) + HORIZON * inp.max_velocity[0])
         inp.target_position = [end, float(inp.current_position[1]) + wrap_angle(yaw - inp.current_position[1])]
         inp.target_velocity = [0.0, 0.0]
-        result = self._otg.update(inp, self._output)
+        try:
+            result = self._otg.update(inp, self._output)
+        except ValueError as error:  # a code the binding's Result enum lacks (an error all the same)
+            result = str(error)
         if result not in (Result.Working, Result.Finished):
             handle.fail(f"route timing failed ({result})")
             self.stop()

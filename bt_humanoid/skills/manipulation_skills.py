@@ -37,7 +37,7 @@ CARRY_FORWARD = 0.38  # m ahead of the base centre where a held object is carrie
 CARRY_SIDE = 0.25  # m to the side of the working hand: outside the shoulder
 CARRY_HEIGHT = 0.95  # m above the floor, at least
 MAX_CARRY_HEIGHT = 1.2  # m: the arm's comfortable limit (torso lifted)
-CARRY_TOLERANCE = (0.03, 0.2)  # m, rad: the carry pose needs no precision
+CARRY_TOLERANCE = (0.05, 0.2)  # m, rad: the carry pose needs no precision (a tall thing held high may fall short)
 IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (or nearer) hides part of it
 
 
