@@ -86,6 +86,29 @@ def test_navigate_to_arrives_at_the_kitchen_without_touching_anything():
     assert contacts == []
 
 
+class _Crawl:
+    """A limiter holding the base to a crawl, as speed and separation monitoring does beside a person."""
+
+    hold_limit = 1e3  # s: longer than the test
+
+    def share(self, velocity: np.ndarray) -> float:
+        return 0.001
+
+    def describe(self) -> str:
+        return "a person close by"
+
+
+def test_a_long_route_held_to_a_crawl_waits_instead_of_failing():
+    run = build_run({"mission": "idle", "tree": {"wait": {"seconds": 0}}}, robot_start=(8.0, -3.0, 0.0))
+    robot, navigator = run.robot, run.navigator
+    robot.base.limiter = _Crawl()
+    handle = navigator.go_to(np.array([1.2, 3.45, 1.57]), 0.6)  # over 9 m: at 1 mm/s, longer than a trajectory lasts
+    assert navigator.follower.route.length > 9.0
+    run.executor.advance(3.0)
+    assert not handle.done, handle.result  # the route timing copes (Ruckig's duration once overflowed)
+    assert np.hypot(*robot.base.speeds()[:2]) < 0.01
+
+
 def test_a_parcel_dropped_on_the_route_is_seen_and_driven_around():
     run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
     navigator = run.navigator

@@ -5,7 +5,6 @@ import pytest
 
 from bt_humanoid.perception.detector import colour_name, detect
 from bt_humanoid.perception.fusion import integrate
-from bt_humanoid.perception.perceiver import MASKED_DEPTH
 from bt_humanoid.perception.rgbd_camera import RgbdCamera
 from bt_humanoid.testing.scenario import build_run
 
@@ -73,9 +72,9 @@ def _hide_left_half_of_the_mug(run, frame) -> None:
     near = np.linalg.norm(frame.points()[..., :2] - mug[:2], axis=-1) < 0.05
     rows, cols = np.nonzero(near & (frame.points()[..., 2] > 0.91))
     cut = cols < np.median(cols)
-    frame.hidden = np.zeros(frame.depth.shape, dtype=bool)
-    frame.hidden[rows[cut], cols[cut]] = True
-    frame.depth[frame.hidden] = MASKED_DEPTH
+    arm = np.zeros(frame.depth.shape, dtype=bool)
+    arm[rows[cut], cols[cut]] = True
+    frame.hide(arm)
 
 
 def test_a_detection_cut_off_by_the_robots_own_arm_is_marked_occluded():
@@ -96,8 +95,7 @@ def test_an_occluded_view_neither_moves_an_object_nor_counts_against_it():
     integrate(belief, detect(frame, list(belief.surfaces.values())), frame)
     assert np.array_equal(mug.position, position) and mug.yaw == yaw  # the cut-off part says nothing of its pose
     assert mug.confidence > confidence  # but it is still there
-    frame.hidden[:] = True  # the arm covers the whole view: nothing seen, nothing lost
-    frame.depth[:] = MASKED_DEPTH
+    frame.hide(np.ones(frame.depth.shape, dtype=bool))  # the arm covers the whole view: nothing seen, nothing lost
     before = mug.confidence
     integrate(belief, detect(frame, list(belief.surfaces.values())), frame)
     assert mug.confidence == before

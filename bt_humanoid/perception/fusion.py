@@ -40,8 +40,7 @@ def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame)
         if tracked is None:
             tracked = _new(belief, detection, frame.time)
         elif detection.occluded:
-            tracked.confidence = min(1.0, tracked.confidence + GAIN)
-            tracked.last_seen = frame.time
+            _confirm(tracked, frame.time)
         else:
             _update(tracked, detection, frame.time)
         seen.add(tracked.id)
@@ -111,11 +110,16 @@ def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject
     return tracked
 
 
+def _confirm(tracked: TrackedObject, time: float) -> None:
+    """A sighting: the object is there now."""
+    tracked.confidence = min(1.0, tracked.confidence + GAIN)
+    tracked.last_seen = time
+
+
 def _update(tracked: TrackedObject, detection: Detection, time: float) -> None:
     tracked.position = (1 - NEW_WEIGHT) * tracked.position + NEW_WEIGHT * detection.position
     tracked.size = (1 - NEW_WEIGHT) * tracked.size + NEW_WEIGHT * detection.size
-    tracked.confidence = min(1.0, tracked.confidence + GAIN)
-    tracked.last_seen = time
+    _confirm(tracked, time)
     tracked.votes[(detection.kind, detection.colour)] += 1
     (kind, colour), _ = tracked.votes.most_common(1)[0]
     if detection.yaw_known or not tracked.yaw_known:  # a seen handle beats any guess

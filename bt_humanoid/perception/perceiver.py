@@ -23,7 +23,6 @@ from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.sim.simulation import Simulation
 
 LOOK_RATE = 1.0  # Hz of background looks while a mission runs
-MASKED_DEPTH = 100.0  # m given to the robot's own pixels: far beyond anything the detector considers
 
 
 class Perceiver:
@@ -81,5 +80,4 @@ class Perceiver:
         geom = segmentation[..., 0]
         is_geom = segmentation[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
         robot = is_geom & self._robot_geoms[np.clip(geom, 0, len(self._robot_geoms) - 1)]
-        frame.depth[robot] = MASKED_DEPTH
-        frame.hidden = robot
+        frame.hide(robot)

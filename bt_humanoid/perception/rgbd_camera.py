@@ -16,6 +16,8 @@ import numpy as np
 
 from bt_humanoid.sim.simulation import Simulation
 
+HIDDEN_DEPTH = 100.0  # m given to pixels the robot's own body covers: far beyond anything the detector considers
+
 
 @dataclass
 class RgbdFrame:
@@ -29,6 +31,11 @@ class RgbdFrame:
     rotation: np.ndarray  # camera axes in the world (3, 3): x right, y up, looking along -z
     time: float
     hidden: np.ndarray | None = None  # (H, W) bool: pixels where the robot's own body blocks the view
+
+    def hide(self, mask: np.ndarray) -> None:
+        """Mark ``mask``'s pixels as covered by the robot's own body: nothing there for the detector."""
+        self.hidden = mask if self.hidden is None else self.hidden | mask
+        self.depth[self.hidden] = HIDDEN_DEPTH
 
     def is_hidden(self, row: int, col: int) -> bool:
         """Whether the robot's own body covers this pixel (what lies behind it is unknown, not absent)."""

@@ -38,7 +38,8 @@ CARRY_SIDE = 0.25  # m to the side of the working hand: outside the shoulder
 CARRY_HEIGHT = 0.95  # m above the floor, at least
 MAX_CARRY_HEIGHT = 1.2  # m: the arm's comfortable limit (torso lifted)
 CARRY_TOLERANCE = (0.05, 0.2)  # m, rad: the carry pose needs no precision (a tall thing held high may fall short)
-IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (or nearer) hides part of it
+IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (and not behind it) hides part of it
+BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its line of sight is behind it
 
 
 class _ManipulationSkill(PhasedSkill):
@@ -233,7 +234,8 @@ class Grasp(_ManipulationSkill):
         to_hand = whole_body.frame_pose(whole_body.hand_frame(side)).translation - eye
         to_object = target.position - eye
         cosine = float(to_hand @ to_object) / max(float(np.linalg.norm(to_hand) * np.linalg.norm(to_object)), 1e-9)
-        if cosine < math.cos(IN_THE_WAY) or np.linalg.norm(to_hand) > np.linalg.norm(to_object) + 0.1:
+        behind = np.linalg.norm(to_hand) > np.linalg.norm(to_object) + BEHIND_MARGIN
+        if cosine < math.cos(IN_THE_WAY) or behind:
             return None
         surface = self.context.world_model.surface_under(target.position)
         clearances = [self._clearance(side, surface, 0.0)] if surface is not None else []
