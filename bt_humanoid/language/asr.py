@@ -5,10 +5,14 @@ commands (see NOTES.md); a JSGF grammar of what the planner understands,
 filled with the world's own words (its objects, colours, places and
 surfaces), decodes them reliably and fast. An utterance may start with the
 wake word ("hey robot"); the transcript keeps it so callers can tell.
-Speech that no path through the grammar fits within the decoder's beams
-comes back as nothing heard, which the planner answers with "I did not
-hear a command"; speech that is out of the grammar but near it is still
-forced onto the nearest command (see the README's voice figures).
+The grammar also holds what the planner understands only to refuse ("pick
+up the table", "pick up the person"), so that the robot refuses what was
+asked instead of picking up the nearest thing that fits. Speech that no
+path through the grammar fits within the decoder's beams comes back as
+nothing heard, which the planner answers with "I did not hear a command";
+speech that is out of the grammar but near it is still forced onto the
+nearest command (see the README's voice figures). The dictionary holds the
+grammar's words in American and British forms (``pronunciation.py``).
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from bt_humanoid.language.audio import RATE
+from bt_humanoid.language.pronunciation import write_dictionary
 from bt_humanoid.language.words import WAKE_WORDS
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
 from bt_humanoid.sim.world_config import WorldConfig
@@ -32,6 +37,11 @@ DECODER_SETTINGS = {  # tuned on the voice benchmark's first noise draw (seed 0)
     "dither": True,  # synthetic silence is exact zeros; without dither the decoder drops the last words
     "bestpath": False,  # the lattice rescoring picks paths that leave the grammar ("Final result does not match")
     "pip": 0.2,  # a lower phone insertion penalty: espeak-ng's fast speech has short phones
+    # Wider beams than the defaults (1e-48, 1e-48, 7e-29): fast or British speech scores poorly early in a word
+    # and was pruned, leaving nothing heard. The looped grammar below keeps this within the latency target.
+    "beam": 1e-60,
+    "pbeam": 1e-60,
+    "wbeam": 1e-40,
 }
 NUMBERS = (  # what distances, angles and counts are spoken as
     "one | two | three | four | five | six | seven | eight | nine | ten | fifteen | twenty | thirty | forty"
@@ -69,6 +79,7 @@ def command_grammar(world: WorldConfig) -> str:
     colours = sorted(c for c in COLOURS if c != "gray")
     places = sorted(p.replace("_", " ") for p in world.places if p != "start")
     surfaces = sorted(world.surfaces)
+    unmovable = sorted({"person", *places, *surfaces})
     rule = " | ".join
     return "\n".join(
         [
@@ -76,9 +87,13 @@ def command_grammar(world: WorldConfig) -> str:
             "grammar robot;",
             f"public <utterance> = [{' | '.join(SPOKEN_WAKE_WORDS)}] [<polite>] <command> [please] [now];",
             "<polite> = please | could you | can you | would you;",
-            "<command> = <clause> [[and] [then] <clause> [[and] [then] <clause>]];  // up to three steps",
+            # Steps are joined by a word, as in "A and B" or "A then B". A command of steps side by side ("where is
+            # the mug" as "wave lift the mug") was the commonest misreading; a spoken comma is heard as "and".
+            # The rule loops (right recursion), so the grammar holds one copy of a step, not one per position.
+            "<command> = <clause> [<next>];",
+            "<next> = (and | then | and then) <clause> [<next>];",
             "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>;",
-            "<take> = (pick up | grab | take | get | lift | collect) <object> | pick <object> up;",
+            "<take> = (pick up | grab | take | get | lift | collect) (<object> | the <unmovable>) | pick <object> up;",
             "<put> = (put | place | set) <thing> [down] (on | onto) <surface> | (move | take | carry) <thing> [over] to"
             " <surface>;",
             "<bring> = (bring | fetch | give | hand | get) me <object> | (bring | take | carry) <thing> to me;",
@@ -95,6 +110,7 @@ def command_grammar(world: WorldConfig) -> str:
             "<description> = [<colour>] <kind> [(on | from) <surface>] [in <place>] | <name>"
             " | (biggest | smallest) thing;",
             f"<name> = {rule(names)};",
+            f"<unmovable> = {rule(unmovable)};  // the planner refuses these with a reason",
             f"<kind> = {rule(kinds)};",
             f"<plural> = {rule(plurals)};",
             f"<colour> = {rule(colours)};",
@@ -136,9 +152,13 @@ class CommandRecognizer:
 
         set_loglevel("FATAL")
         self._folder = tempfile.TemporaryDirectory()
-        grammar = Path(self._folder.name) / "commands.gram"
-        grammar.write_text(command_grammar(world))
-        self.decoder = Decoder(jsgf=str(grammar), samprate=RATE, **DECODER_SETTINGS)
+        folder = Path(self._folder.name)
+        grammar = command_grammar(world)
+        (folder / "commands.gram").write_text(grammar)
+        dictionary = write_dictionary(grammar, folder / "commands.dict", where=f"world {world.name}")
+        self.decoder = Decoder(
+            jsgf=str(folder / "commands.gram"), dict=str(dictionary), samprate=RATE, **DECODER_SETTINGS
+        )
 
     def transcribe(self, samples: np.ndarray) -> Transcript:
         started = time.perf_counter()

@@ -1,0 +1,98 @@
+"""The recogniser's dictionary and grammar, checked as text: British forms, the grammar's words, what it accepts."""
+
+from pathlib import Path
+
+import pytest
+from pocketsphinx import Decoder, Jsgf
+
+from bt_humanoid.errors import UserError
+from bt_humanoid.language.asr import command_grammar
+from bt_humanoid.language.pronunciation import british, grammar_words, write_dictionary
+from bt_humanoid.sim.world_config import load_world_config
+
+
+@pytest.fixture(scope="module")
+def grammar() -> str:
+    return command_grammar(load_world_config("apartment"))
+
+
+def test_a_british_speaker_drops_an_r_that_no_vowel_follows():
+    assert british("M IY T ER") == "M IY T AH"  # meter
+    assert british("F AO R W ER D") == "F AO W AH D"  # forward
+    assert british("W EH R") == "W EH AH"  # where: the r leaves a schwa
+
+
+def test_an_r_before_a_vowel_is_kept():
+    assert british("K AE R IY") == "K AE R IY"  # carry
+    assert british("R OW B AA T") == "R OW B AA T"  # robot
+
+
+def test_half_takes_the_vowel_of_father_but_cat_does_not():
+    assert british("HH AE F") == "HH AA F"
+    assert british("K AE T") == "K AE T"
+
+
+def test_grammar_words_leave_out_rule_names_and_comments():
+    text = "#JSGF V1.0;\ngrammar g;\npublic <u> = stop | say <what>;  // a stop or a greeting\n<what> = hello;\n"
+    assert grammar_words(text) == ["hello", "say", "stop"]
+
+
+def test_the_dictionary_holds_the_grammars_words_in_both_accents(grammar, tmp_path):
+    entries = {}
+    for line in write_dictionary(grammar, tmp_path / "words.dict").read_text().splitlines():
+        word, phones = line.split(" ", 1)
+        entries.setdefault(word.split("(")[0], []).append(phones)
+    assert entries["half"] == ["HH AE F", "HH AA F"]
+    assert "M IY T AH" in entries["meter"]
+    assert {"red", "living", "counter", "robot"} <= set(entries)
+    assert "zebra" not in entries  # only what the grammar can say
+
+
+def test_a_word_the_dictionary_lacks_is_named_with_its_world(tmp_path):
+    with pytest.raises(UserError, match=r"^world attic: .*'zorblax'.*\(name objects"):
+        write_dictionary("public <u> = pick up the zorblax;", tmp_path / "words.dict", where="world attic")
+
+
+def _accepts(grammar: str, words: str, folder: Path) -> bool:
+    """Whether the grammar's finite-state form (pocketsphinx's own compilation) has a path for ``words``."""
+    (folder / "g.gram").write_text(grammar)
+    jsgf = Jsgf(str(folder / "g.gram"))
+    jsgf.build_fsg(jsgf.get_rule("robot.utterance"), Decoder(samprate=16000).logmath, 1.0).writefile(
+        str(folder / "g.fsg")
+    )
+    arcs: dict[int, list[tuple[int, str | None]]] = {}
+    start = final = 0
+    for line in (folder / "g.fsg").read_text().splitlines():
+        fields = line.split()
+        if fields[:1] == ["START_STATE"]:
+            start = int(fields[1])
+        elif fields[:1] == ["FINAL_STATE"]:
+            final = int(fields[1])
+        elif fields[:1] == ["TRANSITION"]:
+            arcs.setdefault(int(fields[1]), []).append((int(fields[2]), fields[4] if len(fields) > 4 else None))
+
+    def closure(states: set[int]) -> set[int]:
+        todo, seen = list(states), set(states)
+        while todo:
+            for to, word in arcs.get(todo.pop(), []):
+                if word is None and to not in seen:
+                    seen.add(to)
+                    todo.append(to)
+        return seen
+
+    states = closure({start})
+    for word in words.split():
+        states = closure({to for s in states for to, w in arcs.get(s, []) if w == word})
+    return final in states
+
+
+def test_steps_are_joined_by_a_word(grammar, tmp_path):
+    assert _accepts(grammar, "go to the table then wave", tmp_path)
+    assert _accepts(grammar, "hey robot go to the kitchen and pick up the mug and then bring it to me", tmp_path)
+    assert not _accepts(grammar, "wave lift the coffee mug", tmp_path)  # "where is the coffee mug", misheard
+
+
+def test_the_grammar_holds_what_the_planner_refuses(grammar, tmp_path):
+    assert _accepts(grammar, "pick up the table", tmp_path)
+    assert _accepts(grammar, "pick up the person", tmp_path)
+    assert not _accepts(grammar, "go to the person now", tmp_path)  # the person is "me": "come to me"
