@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, run_main
-from bt_humanoid.language.asr import CommandRecognizer, command_grammar
+from bt_humanoid.language.asr import CommandRecognizer, command_grammar, frame_power, with_noise_floor
 from bt_humanoid.language.audio import espeak_available, read_wav, spoken, synthesize, with_noise, write_wav
 from bt_humanoid.language.listening import END_SILENCE, Listener, heard_in
 from bt_humanoid.language.whisper_asr import WhisperRecognizer, world_prompt
@@ -37,6 +37,22 @@ def test_a_spoken_command_after_the_wake_word_is_heard(recognizer):
     heard = recognizer.transcribe(spoken("hey robot, put the red cube on the counter"))
     assert heard.woken and heard.command == "put the red cube on the counter"
     assert heard.text in ("hey robot put the red cube on the counter", "robot put the red cube on the counter")
+
+
+def test_a_long_command_without_any_noise_is_heard_whole(recognizer):
+    # espeak-ng leaves digital silence between words; decoded as it is, the second step was lost
+    heard = recognizer.transcribe(spoken("pick up the red cube and put it on the counter"))
+    assert re.fullmatch(r"pick up the red cube (and|then) put it on the counter", heard.text), heard.text
+
+
+def test_a_noise_floor_fills_digital_silence_and_leaves_noisy_speech_alone():
+    clean = spoken("go to the kitchen")
+    floored = frame_power(with_noise_floor(clean))
+    speech = np.percentile(frame_power(clean), 90)
+    assert np.percentile(frame_power(clean), 10) == 0.0
+    assert 10 * np.log10(speech / np.percentile(floored, 10)) == pytest.approx(35.0, abs=3.0)
+    noisy = with_noise(clean, 20.0, np.random.default_rng(0))
+    assert np.array_equal(with_noise_floor(noisy), noisy)
 
 
 def test_wav_files_of_any_rate_come_out_at_16_khz(tmp_path):
