@@ -1,9 +1,9 @@
 """The recogniser's dictionary and grammar, checked as text: British forms, the grammar's words, what it accepts."""
 
-from pathlib import Path
+from collections.abc import Callable
 
 import pytest
-from pocketsphinx import Decoder, Jsgf
+from pocketsphinx import Jsgf, LogMath
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.language.asr import command_grammar
@@ -53,13 +53,13 @@ def test_a_word_the_dictionary_lacks_is_named_with_its_world(tmp_path):
         write_dictionary("public <u> = pick up the zorblax;", tmp_path / "words.dict", where="world attic")
 
 
-def _accepts(grammar: str, words: str, folder: Path) -> bool:
-    """Whether the grammar's finite-state form (pocketsphinx's own compilation) has a path for ``words``."""
+@pytest.fixture(scope="module")
+def accepts(grammar: str, tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], bool]:
+    """Whether the grammar's finite-state form (pocketsphinx's own compilation) has a path for some words."""
+    folder = tmp_path_factory.mktemp("fsg")
     (folder / "g.gram").write_text(grammar)
     jsgf = Jsgf(str(folder / "g.gram"))
-    jsgf.build_fsg(jsgf.get_rule("robot.utterance"), Decoder(samprate=16000).logmath, 1.0).writefile(
-        str(folder / "g.fsg")
-    )
+    jsgf.build_fsg(jsgf.get_rule("robot.utterance"), LogMath(), 1.0).writefile(str(folder / "g.fsg"))
     arcs: dict[int, list[tuple[int, str | None]]] = {}
     start = final = 0
     for line in (folder / "g.fsg").read_text().splitlines():
@@ -80,19 +80,22 @@ def _accepts(grammar: str, words: str, folder: Path) -> bool:
                     todo.append(to)
         return seen
 
-    states = closure({start})
-    for word in words.split():
-        states = closure({to for s in states for to, w in arcs.get(s, []) if w == word})
-    return final in states
+    def accepted(words: str) -> bool:
+        states = closure({start})
+        for word in words.split():
+            states = closure({to for s in states for to, w in arcs.get(s, []) if w == word})
+        return final in states
+
+    return accepted
 
 
-def test_steps_are_joined_by_a_word(grammar, tmp_path):
-    assert _accepts(grammar, "go to the table then wave", tmp_path)
-    assert _accepts(grammar, "hey robot go to the kitchen and pick up the mug and then bring it to me", tmp_path)
-    assert not _accepts(grammar, "wave lift the coffee mug", tmp_path)  # "where is the coffee mug", misheard
+def test_steps_are_joined_by_a_word(accepts):
+    assert accepts("go to the table then wave")
+    assert accepts("hey robot go to the kitchen and pick up the mug and then bring it to me")
+    assert not accepts("wave lift the coffee mug")  # "where is the coffee mug", misheard
 
 
-def test_the_grammar_holds_what_the_planner_refuses(grammar, tmp_path):
-    assert _accepts(grammar, "pick up the table", tmp_path)
-    assert _accepts(grammar, "pick up the person", tmp_path)
-    assert not _accepts(grammar, "go to the person now", tmp_path)  # the person is "me": "come to me"
+def test_the_grammar_holds_what_the_planner_refuses(accepts):
+    assert accepts("pick up the table")
+    assert accepts("pick up the person")
+    assert not accepts("go to the person now")  # the person is "me": "come to me"

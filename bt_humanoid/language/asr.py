@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bt_humanoid.language.audio import RATE
+from bt_humanoid.language.audio import RATE, with_noise
 from bt_humanoid.language.pronunciation import write_dictionary
 from bt_humanoid.language.words import WAKE_WORDS
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
@@ -152,18 +152,13 @@ def with_noise_floor(samples: np.ndarray, below_db: float = NOISE_FLOOR_DB) -> n
 
     Synthetic speech has digital silence between words, far quieter than any microphone. pocketsphinx's
     cepstral mean normalisation then skews, and long commands lost their second half ("pick up the red cube
-    and put it on the counter" was heard as "pick up the red cube"): a quarter of the benchmark's commands,
-    spoken by espeak-ng without noise, were misheard. Input with that much noise already is left as it is.
+    and put it on the counter" was heard as "pick up the red cube"). Input with that much noise already is left
+    as it is.
     """
     power = frame_power(samples)
-    if len(power) < 10:
+    if len(power) < 10 or np.percentile(power, 10) >= np.percentile(power, 90) / 10 ** (below_db / 10):
         return samples
-    wanted = float(np.percentile(power, 90)) / 10 ** (below_db / 10)
-    floor = float(np.percentile(power, 10))
-    if floor >= wanted:
-        return samples
-    noise = np.random.default_rng(0).normal(0.0, np.sqrt(wanted - floor), len(samples))  # seeded: repeatable
-    return np.clip(samples.astype(float) + noise, -32768, 32767).astype(np.int16)
+    return with_noise(samples, below_db, np.random.default_rng(0))  # seeded: the same input is heard the same
 
 
 class CommandRecognizer:

@@ -63,12 +63,16 @@ def read_cmudict(path: Path | None = None) -> dict[str, list[str]]:
     return entries
 
 
-def pronunciations(words: list[str], cmudict: dict[str, list[str]]) -> dict[str, list[str]]:
-    """Each word's American pronunciations and the British forms that differ; a UserError names words CMUdict lacks."""
+def pronunciations(words: list[str], cmudict: dict[str, list[str]], where: str | None = None) -> dict[str, list[str]]:
+    """Each word's American pronunciations and the British forms that differ.
+
+    A word CMUdict lacks is a UserError, at ``where`` (the grammar's source).
+    """
     missing = [w for w in words if w not in cmudict]
     if missing:
         raise UserError(
             f"the recogniser cannot hear {', '.join(repr(w) for w in missing)}: not in pocketsphinx's dictionary",
+            where=where,
             hint="name objects, places and surfaces with English words",
         )
     result = {}
@@ -81,12 +85,8 @@ def pronunciations(words: list[str], cmudict: dict[str, list[str]]) -> dict[str,
 
 def write_dictionary(grammar: str, path: Path, where: str | None = None) -> Path:
     """A pocketsphinx dictionary of the grammar's words, in both accents, at ``path``; ``where`` names the source."""
-    try:
-        words = pronunciations(grammar_words(grammar), read_cmudict())
-    except UserError as error:
-        raise UserError(error.message, where=where, hint=error.hint) from None
     lines = []
-    for word, forms in words.items():
+    for word, forms in pronunciations(grammar_words(grammar), read_cmudict(), where).items():
         lines += [f"{word if i == 0 else f'{word}({i + 1})'} {phones}" for i, phones in enumerate(forms)]
     path.write_text("\n".join(lines) + "\n")
     return path
