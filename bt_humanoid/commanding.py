@@ -23,6 +23,7 @@ from bt_humanoid.language.listening import Listener, heard_in
 from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
 from bt_humanoid.language.questions import Questions
+from bt_humanoid.language.words import UNCLEAR
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import RecoverySettings
 from bt_humanoid.mission.spec import MissionSpec
@@ -119,7 +120,13 @@ def plan_command(
     answers: Callable[[str], str | None],
     planner: EmbeddedPlanner | LlmPlanner | None = None,
 ) -> CommandOutcome:
-    """Plan ``text``; each question goes to ``answers`` (None: no answer, the question stands)."""
+    """Plan ``text``; each question goes to ``answers`` (None: no answer, the question stands).
+
+    Speech the recogniser could not make out (``UNCLEAR`` in a transcript) is refused before any planner sees
+    it: the robot does not guess at the words it did not know.
+    """
+    if UNCLEAR in text:
+        return CommandOutcome(Plan("refusal", "I could not make out all the words. Please say it another way."), None)
     planner = planner or EmbeddedPlanner()
     plan = planner.plan(text, context)
     for _ in range(MAX_QUESTIONS):

@@ -7,7 +7,7 @@ from pocketsphinx import Jsgf, LogMath
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.language.asr import command_grammar
-from bt_humanoid.language.pronunciation import british, grammar_words, write_dictionary
+from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, british, grammar_words, write_dictionary
 from bt_humanoid.sim.world_config import load_world_config
 
 
@@ -46,6 +46,7 @@ def test_the_dictionary_holds_the_grammars_words_in_both_accents(grammar, tmp_pa
     assert "M IY T AH" in entries["meter"]
     assert {"red", "living", "counter", "robot"} <= set(entries)
     assert "zebra" not in entries  # only what the grammar can say
+    assert entries[UNCLEAR_SPEECH] == ["+SPN+"]  # unclear speech is the acoustic model's spoken noise
 
 
 def test_a_word_the_dictionary_lacks_is_named_with_its_world(tmp_path):
@@ -99,3 +100,13 @@ def test_the_grammar_holds_what_the_planner_refuses(accepts):
     assert accepts("pick up the table")
     assert accepts("pick up the person")
     assert not accepts("go to the person now")  # the person is "me": "come to me"
+
+
+def test_unclear_speech_stands_for_a_step_an_object_or_a_surface(accepts):
+    unclear = f"{UNCLEAR_SPEECH} {UNCLEAR_SPEECH}"
+    assert accepts(unclear)  # "make me a sandwich"
+    assert accepts(f"wave and then {unclear}")
+    assert accepts(f"bring me the {unclear}")  # "bring me the banana"
+    assert accepts(f"put the red cube on the {unclear}")  # "on the ceiling"
+    assert not accepts(f"pick up the red {unclear}")  # not after a known word of the same phrase
+    assert not accepts(f"turn left {unclear} degrees")  # nor for a number

@@ -9,12 +9,16 @@ import numpy as np
 import pytest
 
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, run_main
-from bt_humanoid.language.asr import CommandRecognizer, command_grammar, frame_power, with_noise_floor
+from bt_humanoid.commanding import plan_command
+from bt_humanoid.language.asr import CommandRecognizer, command_grammar, frame_power, heard_words, with_noise_floor
 from bt_humanoid.language.audio import espeak_available, read_wav, spoken, synthesize, with_noise, write_wav
 from bt_humanoid.language.listening import END_SILENCE, Listener, heard_in
+from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH
 from bt_humanoid.language.whisper_asr import WhisperRecognizer, world_prompt
+from bt_humanoid.language.words import UNCLEAR
 from bt_humanoid.paths import project_root
 from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.testing.told import told_planning_context
 
 
 def test_espeak_ng_is_installed_by_the_set_up():
@@ -43,6 +47,24 @@ def test_a_long_command_without_any_noise_is_heard_whole(recognizer):
     # espeak-ng leaves digital silence between words; decoded as it is, the second step was lost
     heard = recognizer.transcribe(spoken("pick up the red cube and put it on the counter"))
     assert re.fullmatch(r"pick up the red cube (and|then) put it on the counter", heard.text), heard.text
+
+
+@pytest.mark.parametrize("voice", ["en-us", "en-gb"])
+def test_words_the_robot_does_not_know_are_heard_as_unclear_and_refused(recognizer, voice):
+    # Without the grammar's unclear speech this was heard as a command that fits ("lift the cup and wave")
+    heard = recognizer.transcribe(spoken("hey robot, make me a cup of tea", voice))
+    assert heard.woken and UNCLEAR in heard.command, heard.text
+    outcome = plan_command(heard.command, told_planning_context("apartment"), lambda _: None)
+    assert outcome.plan.kind == "refusal" and outcome.spec is None
+    assert "could not make out" in outcome.plan.say
+
+
+def test_a_stretch_of_unclear_speech_is_written_as_one_mark():
+    class Hypothesis:
+        hypstr = f"bring me the {UNCLEAR_SPEECH} {UNCLEAR_SPEECH}  and {UNCLEAR_SPEECH}"
+
+    assert heard_words(Hypothesis()) == f"bring me the {UNCLEAR} and {UNCLEAR}"
+    assert heard_words(None) == ""
 
 
 def test_a_noise_floor_fills_digital_silence_and_leaves_noisy_speech_alone():

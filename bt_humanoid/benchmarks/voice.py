@@ -35,6 +35,7 @@ import numpy as np
 import yaml
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
+from bt_humanoid.commanding import plan_command
 from bt_humanoid.language.asr import CommandRecognizer, Transcript
 from bt_humanoid.language.audio import RATE, spoken, with_noise
 from bt_humanoid.language.embedded import EmbeddedPlanner
@@ -75,8 +76,9 @@ def streamed(recognizer: CommandRecognizer, clean: np.ndarray, rng: np.random.Ge
 
 
 def planned(planner: EmbeddedPlanner, heard: Transcript, context: PlanningContext) -> dict[str, Any]:
-    """What the embedded planner makes of a transcript (steps and targets, a question, a refusal or a stop)."""
-    return plan_outcome(planner.plan(heard.command or "(nothing heard)", context))
+    """What the robot makes of a transcript, as ``bt-run`` plans it (steps and targets, a question, a refusal or a
+    stop); questions go unanswered."""
+    return plan_outcome(plan_command(heard.command or "(nothing heard)", context, lambda _: None, planner).plan)
 
 
 def main(argv: list[str] | None = None) -> int:

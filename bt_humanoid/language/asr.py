@@ -7,28 +7,35 @@ surfaces), decodes them reliably and fast. An utterance may start with the
 wake word ("hey robot"); the transcript keeps it so callers can tell.
 The grammar also holds what the planner understands only to refuse ("pick
 up the table", "pick up the person"), so that the robot refuses what was
-asked instead of picking up the nearest thing that fits. Speech that no
-path through the grammar fits within the decoder's beams comes back as
-nothing heard, which the planner answers with "I did not hear a command";
-speech that is out of the grammar but near it is still forced onto the
-nearest command (see the README's voice figures). The dictionary holds the
+asked instead of picking up the nearest thing that fits. Words the robot
+does not know are heard as unclear speech, a garbage model in the places
+where they are said (a whole step, an object, a surface): "make me a
+sandwich" is heard as "…" and "bring me the banana" as "bring me the …",
+which the robot refuses, instead of the nearest command that fits ("lift
+the dice and wave"). Speech that no path through the grammar fits within
+the decoder's beams comes back as nothing heard. The dictionary holds the
 grammar's words in American and British forms (``pronunciation.py``).
 """
 
 from __future__ import annotations
 
+import re
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from bt_humanoid.language.audio import RATE, with_noise
-from bt_humanoid.language.pronunciation import write_dictionary
-from bt_humanoid.language.words import WAKE_WORDS
+from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, write_dictionary
+from bt_humanoid.language.words import UNCLEAR, WAKE_WORDS
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
 from bt_humanoid.sim.world_config import WorldConfig
+
+if TYPE_CHECKING:
+    from pocketsphinx import Hypothesis
 
 WAKE_WORD = WAKE_WORDS[0]  # "hey robot": the one people are told to say
 SPOKEN_WAKE_WORDS = (WAKE_WORD, "robot")  # what the grammar hears; "hey" is short and often lost in noise
@@ -94,7 +101,8 @@ def command_grammar(world: WorldConfig) -> str:
             # The rule loops (right recursion), so the grammar holds one copy of a step, not one per position.
             "<command> = <clause> [<next>];",
             "<next> = (and | then | and then) <clause> [<next>];",
-            "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>;",
+            "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>"
+            " | <unclear>;",
             "<take> = (pick up | grab | take | get | lift | collect) (<object> | the <unmovable>) | pick <object> up;",
             "<put> = (put | place | set) <thing> [down] (on | onto) <surface> | (move | take | carry) <thing> [over] to"
             " <surface>;",
@@ -108,7 +116,7 @@ def command_grammar(world: WorldConfig) -> str:
             "<stop> = stop | halt | freeze;",
             "<say> = say (hello [everyone] | goodbye | done | thank you);",
             "<thing> = <object> | it | them | all the [<colour>] <plural> | both [<colour>] <plural>;",
-            "<object> = the <description> | something to (drink | play with);",
+            "<object> = the <description> | something to (drink | play with) | the <unclear>;",
             "<description> = [<colour>] <kind> [(on | from) <surface>] [in <place>] | <name>"
             " | (biggest | smallest) thing;",
             f"<name> = {rule(names)};",
@@ -116,9 +124,12 @@ def command_grammar(world: WorldConfig) -> str:
             f"<kind> = {rule(kinds)};",
             f"<plural> = {rule(plurals)};",
             f"<colour> = {rule(colours)};",
-            f"<surface> = the [kitchen | dining] ({rule(surfaces)});",
+            f"<surface> = the [kitchen | dining] ({rule(surfaces)}) | the <unclear>;",
             f"<place> = the ({rule(places)}) | <surface>;",
             f"<number> = {NUMBERS};",
+            # Words the robot does not know, where people say them: a step ("make me a sandwich"), an object
+            # ("bring me the banana") or a surface ("put it on the ceiling"). Heard as UNCLEAR, and refused.
+            f"<unclear> = {UNCLEAR_SPEECH}+;",
             "",
         ]
     )
@@ -196,13 +207,17 @@ class CommandRecognizer:
     def hear(self, chunk: np.ndarray) -> str:
         """Decode the next chunk of the utterance; the best words so far ("" before any)."""
         self.decoder.process_raw(np.asarray(chunk, dtype=np.int16).tobytes(), False, False)
-        hypothesis = self.decoder.hyp()
-        return " ".join(hypothesis.hypstr.split()) if hypothesis is not None else ""
+        return heard_words(self.decoder.hyp())
 
     def end(self, started: float | None = None) -> Transcript:
         """Finish the utterance: what was said, and the time taken since ``started`` (default: now)."""
         started = time.perf_counter() if started is None else started
         self.decoder.end_utt()
-        hypothesis = self.decoder.hyp()
-        text = " ".join(hypothesis.hypstr.split()) if hypothesis is not None else ""
-        return Transcript(text, time.perf_counter() - started)
+        return Transcript(heard_words(self.decoder.hyp()), time.perf_counter() - started)
+
+
+def heard_words(hypothesis: Hypothesis | None) -> str:
+    """A decoder's words as a transcript: single spaces, and UNCLEAR for each stretch of unclear speech."""
+    if hypothesis is None:
+        return ""
+    return " ".join(re.sub(rf"(?:\b{UNCLEAR_SPEECH}\b\s*)+", f"{UNCLEAR} ", hypothesis.hypstr).split())

@@ -20,6 +20,11 @@ from bt_humanoid.errors import UserError
 VOWELS = frozenset({"AA", "AE", "AH", "AO", "AW", "AY", "EH", "ER", "EY", "IH", "IY", "OW", "OY", "UH", "UW"})
 BATH_CONSONANTS = frozenset({"F", "S", "TH"})  # "half", "after", "glass", "path": the vowel of "father" in British
 CENTRING = frozenset({"IH", "EH", "UH"})  # "here", "there", "tour": the lost r leaves a schwa behind
+# The grammar's word for speech that is not one of its words, said as the acoustic model's "spoken noise"
+# (+SPN+, trained on mumbling and fragments). A run of it is heard where a person says something the robot does
+# not know ("bring me the banana" is heard as "bring me the" and it), instead of the nearest word that fits.
+UNCLEAR_SPEECH = "unclear_speech"
+SPOKEN_NOISE = "+SPN+"
 
 
 def cmudict_path() -> Path:
@@ -51,7 +56,7 @@ def grammar_words(grammar: str) -> list[str]:
     """The words a JSGF grammar can produce (its rule names, header, weights and comments left out)."""
     body = "\n".join(line for line in grammar.splitlines() if not line.startswith(("#JSGF", "grammar ")))
     body = re.sub(r"<[^>]*>|//.*|/[0-9.]+/|\bpublic\b", " ", body)
-    return sorted(set(re.findall(r"[a-z']+", body)))
+    return sorted(set(re.findall(r"[a-z'_]+", body)))
 
 
 def read_cmudict(path: Path | None = None) -> dict[str, list[str]]:
@@ -84,9 +89,14 @@ def pronunciations(words: list[str], cmudict: dict[str, list[str]], where: str |
 
 
 def write_dictionary(grammar: str, path: Path, where: str | None = None) -> Path:
-    """A pocketsphinx dictionary of the grammar's words, in both accents, at ``path``; ``where`` names the source."""
-    lines = []
-    for word, forms in pronunciations(grammar_words(grammar), read_cmudict(), where).items():
+    """A pocketsphinx dictionary of the grammar's words, in both accents, at ``path``; ``where`` names the source.
+
+    The grammar's ``UNCLEAR_SPEECH`` word is spoken noise.
+    """
+    words = grammar_words(grammar)
+    lines = [f"{UNCLEAR_SPEECH} {SPOKEN_NOISE}"] if UNCLEAR_SPEECH in words else []
+    spoken = [w for w in words if w != UNCLEAR_SPEECH]
+    for word, forms in pronunciations(spoken, read_cmudict(), where).items():
         lines += [f"{word if i == 0 else f'{word}({i + 1})'} {phones}" for i, phones in enumerate(forms)]
     path.write_text("\n".join(lines) + "\n")
     return path

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 
+UNCLEAR = "…"  # stands in a transcript for speech the recogniser could not make out ("bring me the …")
 WAKE_WORDS = ("hey robot", "ok robot", "okay robot", "robot")
 POLITE = ("please", "could you", "can you", "would you", "will you", "i want you to", "i would like you to")
 
