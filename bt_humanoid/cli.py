@@ -289,7 +289,7 @@ def _listener_thread(args: argparse.Namespace, lines, session, console: Console)
 
     blocks = microphone_blocks() if args.listen == "microphone" else file_blocks(Path(args.listen))
     world = session.run.context.world
-    listener = Listener(CommandRecognizer(world), transcriber=_transcriber(args, world))
+    listener = Listener(CommandRecognizer(world, dictation=True), transcriber=_transcriber(args, world))
 
     def show(label: str, words: str) -> None:
         console.print(f"[bold]{escape(label)}:[/] {escape(words)}", highlight=False)
@@ -331,8 +331,8 @@ def _heard_command(args: argparse.Namespace, console: Console) -> str:
     audio = args.audio
     world = load_world_config(args.world)
     samples = wav_samples(audio, "give a WAV file of a spoken command")
-    heard = (_transcriber(args, world) or CommandRecognizer(world)).transcribe(samples)
-    console.print(f"[bold]heard:[/] {heard.text or '(nothing I understand)'}", highlight=False)
+    heard = (_transcriber(args, world) or CommandRecognizer(world, dictation=True)).transcribe(samples)
+    console.print(f"[bold]heard:[/] {heard.shown or '(nothing I understand)'}", highlight=False)
     if not heard.woken:
         raise UserError(f"{audio}: no '{WAKE_WORD}' at the start", hint=f"say '{WAKE_WORD}, …' and then the command")
     if not heard.command:

@@ -277,7 +277,7 @@ def relay_heard(
             show("heard", heard.text)
             lines.put("stop")
         elif transcript.woken or awaiting_answer():
-            show("heard", heard.text)
+            show("heard", transcript.shown)
             lines.put(transcript.command)
         else:
             show(f"heard (no '{WAKE_WORD}', not for me)", heard.text)

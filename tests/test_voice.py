@@ -27,7 +27,7 @@ def test_espeak_ng_is_installed_by_the_set_up():
 
 @pytest.fixture(scope="module")
 def recognizer() -> CommandRecognizer:
-    return CommandRecognizer(load_world_config("apartment"))
+    return CommandRecognizer(load_world_config("apartment"), dictation=True)
 
 
 def test_the_grammar_speaks_the_worlds_words():
@@ -40,6 +40,7 @@ def test_the_grammar_speaks_the_worlds_words():
 def test_a_spoken_command_after_the_wake_word_is_heard(recognizer):
     heard = recognizer.transcribe(spoken("hey robot, put the red cube on the counter"))
     assert heard.woken and heard.command == "put the red cube on the counter"
+    assert heard.dictated == ""  # free dictation is only for unclear speech
     assert heard.text in ("hey robot put the red cube on the counter", "robot put the red cube on the counter")
 
 
@@ -54,6 +55,7 @@ def test_words_the_robot_does_not_know_are_heard_as_unclear_and_refused(recogniz
     # Without the grammar's unclear speech this was heard as a command that fits ("lift the cup and wave")
     heard = recognizer.transcribe(spoken("hey robot, make me a cup of tea", voice))
     assert heard.woken and UNCLEAR in heard.command, heard.text
+    assert heard.dictated and f"(free dictation: {heard.dictated})" in heard.shown  # its words shown, not planned
     outcome = plan_command(heard.command, told_planning_context("apartment"), lambda _: None)
     assert outcome.plan.kind == "refusal" and outcome.spec is None
     assert "could not make out" in outcome.plan.say
@@ -206,6 +208,7 @@ def test_whisper_text_is_brought_to_the_recognisers_form():
     whisper = WhisperRecognizer(model, prompt=world_prompt(load_world_config("apartment")))
     heard = whisper.transcribe(np.full(16000, 16384, dtype=np.int16))
     assert heard.woken and heard.command == "put the red cube on the counter"
+    assert heard.dictated == ""  # free dictation is only for unclear speech
     call = model.calls[0]
     assert call["audio"].dtype == np.float32 and abs(call["audio"].max() - 0.5) < 1e-6  # int16 → [-1, 1)
     assert call["language"] == "en" and "red cube" in call["initial_prompt"]

@@ -1,7 +1,8 @@
 """Offline speech recognition: pocketsphinx with a grammar of the robot's commands in this world.
 
 Free dictation with pocketsphinx's general language model is poor on short
-commands (see NOTES.md); a JSGF grammar of what the planner understands,
+commands (see NOTES.md), so it is only a fallback shown to the person where
+the grammar heard unclear speech (``FreeDictation``); a JSGF grammar of what the planner understands,
 filled with the world's own words (its objects, colours, places and
 surfaces), decodes them reliably and fast. An utterance may start with the
 wake word ("hey robot"); the transcript keeps it so callers can tell.
@@ -35,7 +36,7 @@ from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
 from bt_humanoid.sim.world_config import WorldConfig
 
 if TYPE_CHECKING:
-    from pocketsphinx import Hypothesis
+    from pocketsphinx import Decoder, Hypothesis
 
 WAKE_WORD = WAKE_WORDS[0]  # "hey robot": the one people are told to say
 SPOKEN_WAKE_WORDS = (WAKE_WORD, "robot")  # what the grammar hears; "hey" is short and often lost in noise
@@ -63,6 +64,12 @@ NUMBERS = (  # what distances, angles and counts are spoken as
 class Transcript:
     text: str  # what was heard, lower case; empty if nothing fitted the grammar
     seconds: float  # wall time the decoding took
+    dictated: str = ""  # free dictation's words, where the grammar heard unclear speech (shown, never planned)
+
+    @property
+    def shown(self) -> str:
+        """What was heard, as the robot tells the person: with free dictation's words where the grammar had none."""
+        return f"{self.text} (free dictation: {self.dictated})" if self.dictated else self.text
 
     @property
     def wake_word(self) -> str | None:
@@ -158,6 +165,12 @@ def speech_span(samples: np.ndarray, frame: float = 0.01, margin: float = 0.15) 
     return samples[first * size : last * size]
 
 
+def prepared(samples: np.ndarray) -> np.ndarray:
+    """An utterance as the decoders hear it: the speech, a noise floor under it, and silence either side."""
+    quiet = np.zeros(int(PADDING * RATE), dtype=np.int16)  # room before and after: the last word is not cut
+    return np.concatenate([quiet, with_noise_floor(speech_span(np.asarray(samples, dtype=np.int16))), quiet])
+
+
 def with_noise_floor(samples: np.ndarray, below_db: float = NOISE_FLOOR_DB) -> np.ndarray:
     """``samples`` with white noise ``below_db`` under the speech added, if they are quieter than that anywhere.
 
@@ -179,7 +192,7 @@ class CommandRecognizer:
     heard so far) and ``end``, so that most of the decoding is done while the person is still speaking.
     """
 
-    def __init__(self, world: WorldConfig) -> None:
+    def __init__(self, world: WorldConfig, dictation: bool = False) -> None:
         from pocketsphinx import Decoder, set_loglevel
 
         set_loglevel("FATAL")
@@ -191,14 +204,18 @@ class CommandRecognizer:
         self.decoder = Decoder(
             jsgf=str(folder / "commands.gram"), dict=str(dictionary), samprate=RATE, **DECODER_SETTINGS
         )
+        self.dictation = FreeDictation() if dictation else None  # what unclear speech was, in any words
 
     def transcribe(self, samples: np.ndarray) -> Transcript:
         started = time.perf_counter()
-        quiet = np.zeros(int(PADDING * RATE), dtype=np.int16)  # room before and after: the last word is not cut
+        utterance = prepared(samples)
         self.begin()
-        utterance = np.concatenate([quiet, with_noise_floor(speech_span(np.asarray(samples, dtype=np.int16))), quiet])
         self.decoder.process_raw(utterance.tobytes(), full_utt=True)
-        return self.end(started)
+        transcript = self.end(started)
+        if self.dictation is not None and UNCLEAR in transcript.text:
+            transcript.dictated = self.dictation.words(utterance)
+            transcript.seconds = time.perf_counter() - started
+        return transcript
 
     def begin(self) -> None:
         """Start an utterance of a stream."""
@@ -221,3 +238,27 @@ def heard_words(hypothesis: Hypothesis | None) -> str:
     if hypothesis is None:
         return ""
     return " ".join(re.sub(rf"(?:\b{UNCLEAR_SPEECH}\b\s*)+", f"{UNCLEAR} ", hypothesis.hypstr).split())
+
+
+class FreeDictation:
+    """Free dictation: pocketsphinx's general English language model, for what the command grammar cannot tell.
+
+    It hears any words, but poorly and slowly on short commands: "pick up the red cube" as "the government you",
+    "make me a cup of tea" as "leave me a cup of tea", in about 0.6 s (the voice benchmark). So it is a fallback
+    the person is shown, to see what went wrong, and never a command the robot acts on. It loads on first use.
+    """
+
+    def __init__(self) -> None:
+        self._decoder: Decoder | None = None
+
+    def words(self, utterance: np.ndarray) -> str:
+        """The words of ``utterance`` (as ``prepared`` gives it) in the general model's best guess."""
+        if self._decoder is None:
+            from pocketsphinx import Decoder
+
+            # The default model (en-us LM, CMUdict); no second (flat) pass: a third faster, no worse on commands
+            self._decoder = Decoder(samprate=RATE, dither=True, seed=DECODER_SETTINGS["seed"], fwdflat=False)
+        self._decoder.start_utt()
+        self._decoder.process_raw(np.asarray(utterance, dtype=np.int16).tobytes(), full_utt=True)
+        self._decoder.end_utt()
+        return heard_words(self._decoder.hyp())
