@@ -125,7 +125,7 @@ def plan_command(
     Speech the recogniser could not make out (``UNCLEAR`` in a transcript) is refused before any planner sees
     it: the robot does not guess at the words it did not know.
     """
-    if UNCLEAR in text:
+    if UNCLEAR in text.split():  # a word of its own, as transcripts write it; not a typed "mug…"
         return CommandOutcome(Plan("refusal", "I could not make out all the words. Please say it another way."), None)
     planner = planner or EmbeddedPlanner()
     plan = planner.plan(text, context)

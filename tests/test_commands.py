@@ -9,6 +9,7 @@ from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, plan_main, run_main
 from bt_humanoid.commanding import InteractiveSession, context_at_start, plan_command
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.language.embedded import EmbeddedPlanner
+from bt_humanoid.testing.told import told_planning_context
 
 
 def test_bt_plan_prints_the_mission_it_would_run(capsys):
@@ -114,3 +115,13 @@ def test_an_interactive_session_takes_commands_answers_and_a_stop_on_one_simulat
     assert session.results[-1].safety == "stop: stop (typed)"
     assert said[-1].startswith("I can't do a backflip.")
     assert session.run.robot.max_speed() < 0.01
+
+
+def test_a_transcript_with_unclear_speech_is_refused_but_a_typed_ellipsis_is_not():
+    context = told_planning_context("apartment")
+    # The embedded planner alone would pick up the red cube and wave: it skips words it does not know
+    for heard in ("pick up the red …", "wave and …"):
+        outcome = plan_command(heard, context, lambda _: None)
+        assert outcome.plan.kind == "refusal" and outcome.spec is None
+        assert "could not make out" in outcome.plan.say
+    assert plan_command("pick up the red cube…", context, lambda _: None).plan.kind == "mission"

@@ -21,8 +21,8 @@ VOWELS = frozenset({"AA", "AE", "AH", "AO", "AW", "AY", "EH", "ER", "EY", "IH", 
 BATH_CONSONANTS = frozenset({"F", "S", "TH"})  # "half", "after", "glass", "path": the vowel of "father" in British
 CENTRING = frozenset({"IH", "EH", "UH"})  # "here", "there", "tour": the lost r leaves a schwa behind
 # The grammar's word for speech that is not one of its words, said as the acoustic model's "spoken noise"
-# (+SPN+, trained on mumbling and fragments). A run of it is heard where a person says something the robot does
-# not know ("bring me the banana" is heard as "bring me the" and it), instead of the nearest word that fits.
+# (+SPN+, its model of speech nobody could transcribe). A run of it is heard where a person says something the
+# robot does not know ("bring me the banana" as "bring me the" and it), instead of the nearest word that fits.
 UNCLEAR_SPEECH = "unclear_speech"
 SPOKEN_NOISE = "+SPN+"
 
