@@ -23,7 +23,7 @@ from bt_humanoid.language.listening import Listener, heard_in
 from bt_humanoid.language.llm import LlmPlanner, LlmSettings, PlanRejected
 from bt_humanoid.language.plan import Plan, PlanningContext
 from bt_humanoid.language.questions import Questions
-from bt_humanoid.language.words import UNCLEAR
+from bt_humanoid.language.words import is_unclear
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import RecoverySettings
 from bt_humanoid.mission.spec import MissionSpec
@@ -125,7 +125,7 @@ def plan_command(
     Speech the recogniser could not make out (``UNCLEAR`` in a transcript) is refused before any planner sees
     it: the robot does not guess at the words it did not know.
     """
-    if UNCLEAR in text.split():  # a word of its own, as transcripts write it; not a typed "mug…"
+    if is_unclear(text):
         return CommandOutcome(Plan("refusal", "I could not make out all the words. Please say it another way."), None)
     planner = planner or EmbeddedPlanner()
     plan = planner.plan(text, context)

@@ -20,10 +20,10 @@ commands of 2.5 to 3.5 seconds; for the stream, the time from the end of the
 utterance to its transcript, after the listener's silence wait), stops the
 stream reported in commands that are not stops, how many were heard with
 unclear speech (refused; free dictation is shown to the person) and the
-recogniser's time on those, the accuracy on the same
-speech without noise (as espeak-ng writes it, with digital silence between
-words), and the embedded planner's latency from typed text to a validated
-mission. Pinned to one CPU core;
+recogniser's time on those, the accuracy on the same speech without noise
+(as espeak-ng writes it, with digital silence between words), and the
+embedded planner's latency from typed text to a validated mission. Pinned
+to one CPU core;
 ``--json PATH`` also writes the figures.
 """
 
@@ -43,7 +43,7 @@ from bt_humanoid.language.audio import RATE, spoken, with_noise
 from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.language.listening import END_SILENCE, Listener
 from bt_humanoid.language.plan import PlanningContext, plan_outcome
-from bt_humanoid.language.words import UNCLEAR, normalise
+from bt_humanoid.language.words import normalise
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.paths import project_root
 from bt_humanoid.testing.told import told_planning_context
@@ -101,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     stream_latencies: list[float] = []
     latencies: list[float] = []
     three_seconds: list[float] = []
-    dictated: list[float] = []  # seconds of the whole utterances heard with unclear speech (free dictation ran)
+    unclear_seconds: list[float] = []  # recogniser time on whole utterances heard with unclear speech
     misses: list[str] = []
     typed: list[float] = []
     for command in commands:
@@ -120,8 +120,8 @@ def main(argv: list[str] | None = None) -> int:
                 for _ in range(args.repeats):
                     heard = recognizer.transcribe(with_noise(clean, SNR_DB, rng))
                     latencies.append(heard.seconds)
-                    if UNCLEAR in heard.text:
-                        dictated.append(heard.seconds)
+                    if heard.unclear:
+                        unclear_seconds.append(heard.seconds)
                     if three_second:
                         three_seconds.append(heard.seconds)
                     got = planned(planner, heard, context)
@@ -146,8 +146,8 @@ def main(argv: list[str] | None = None) -> int:
         "asr_latency_median_ms": statistics.median(latencies) * 1000,
         "asr_latency_3s_median_ms": statistics.median(three_seconds) * 1000 if three_seconds else None,
         "three_second_commands": len(three_seconds),
-        "unclear_utterances": len(dictated),
-        "unclear_latency_median_ms": statistics.median(dictated) * 1000 if dictated else None,
+        "unclear_utterances": len(unclear_seconds),
+        "unclear_latency_median_ms": statistics.median(unclear_seconds) * 1000 if unclear_seconds else None,
         "stream_command_accuracy": stream_correct / total,
         "stream_latency_3s_median_ms": statistics.median(stream_latencies) * 1000 if stream_latencies else None,
         "stream_silence_wait_ms": END_SILENCE * 1000,
@@ -166,8 +166,8 @@ def main(argv: list[str] | None = None) -> int:
         f"({len(three_seconds)}) median {figures['asr_latency_3s_median_ms'] or float('nan'):.0f} ms (≤ 300 ms)"
     )
     print(
-        f"  heard with unclear speech (refused; free dictation shown): {len(dictated)}, recogniser latency median "
-        f"{figures['unclear_latency_median_ms'] or float('nan'):.0f} ms with the dictation"
+        f"  heard with unclear speech (refused; free dictation shown): {figures['unclear_utterances']}, recogniser "
+        f"latency median {figures['unclear_latency_median_ms'] or float('nan'):.0f} ms with the dictation"
     )
     print(f"  streamed (listener): planned as typed {figures['stream_command_accuracy']:.1%}; ", end="")
     print(

@@ -2,20 +2,20 @@
 
 Free dictation with pocketsphinx's general language model is poor on short
 commands (see NOTES.md), so it is only a fallback shown to the person where
-the grammar heard unclear speech (``FreeDictation``); a JSGF grammar of what the planner understands,
-filled with the world's own words (its objects, colours, places and
-surfaces), decodes them reliably and fast. An utterance may start with the
-wake word ("hey robot"); the transcript keeps it so callers can tell.
-The grammar also holds what the planner understands only to refuse ("pick
-up the table", "pick up the person"), so that the robot refuses what was
-asked instead of picking up the nearest thing that fits. Words the robot
-does not know are heard as unclear speech, a garbage model in the places
-where they are said (a whole step, an object, a surface): "make me a
-sandwich" is heard as "…" and "bring me the banana" as "bring me the …",
-which the robot refuses, instead of the nearest command that fits ("lift
-the dice and wave"). Speech that no path through the grammar fits within
-the decoder's beams comes back as nothing heard. The dictionary holds the
-grammar's words in American and British forms (``pronunciation.py``).
+the grammar heard unclear speech (``FreeDictation``). A JSGF grammar of what
+the planner understands, filled with the world's own words (its objects,
+colours, places and surfaces), decodes them reliably and fast. An utterance
+may start with the wake word ("hey robot"); the transcript keeps it so
+callers can tell. The grammar also holds what the planner understands only
+to refuse ("pick up the table", "pick up the person"), so that the robot
+refuses what was asked instead of picking up the nearest thing that fits.
+Words the robot does not know are heard as unclear speech, a garbage model
+in the places where they are said (a whole step, an object, a surface):
+"make me a sandwich" is heard as "…" and "bring me the banana" as "bring me
+the …", which the robot refuses, instead of the nearest command that fits
+("lift the dice and wave"). Speech that no path through the grammar fits
+within the decoder's beams comes back as nothing heard. The dictionary holds
+the grammar's words in American and British forms (``pronunciation.py``).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ import numpy as np
 
 from bt_humanoid.language.audio import RATE, with_noise
 from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, write_dictionary
-from bt_humanoid.language.words import UNCLEAR, WAKE_WORDS
+from bt_humanoid.language.words import UNCLEAR, WAKE_WORDS, is_unclear
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
 from bt_humanoid.sim.world_config import WorldConfig
 
@@ -70,6 +70,11 @@ class Transcript:
     def shown(self) -> str:
         """What was heard, as the robot tells the person: with free dictation's words where the grammar had none."""
         return f"{self.text} (free dictation: {self.dictated})" if self.dictated else self.text
+
+    @property
+    def unclear(self) -> bool:
+        """Whether some of the speech fitted none of the grammar's words (UNCLEAR in the text)."""
+        return is_unclear(self.text)
 
     @property
     def wake_word(self) -> str | None:
@@ -212,7 +217,7 @@ class CommandRecognizer:
         self.begin()
         self.decoder.process_raw(utterance.tobytes(), full_utt=True)
         transcript = self.end(started)
-        if self.dictation is not None and UNCLEAR in transcript.text:
+        if self.dictation is not None and transcript.unclear:
             transcript.dictated = self.dictation.words(utterance)
             transcript.seconds = time.perf_counter() - started
         return transcript

@@ -44,6 +44,12 @@ NUMBER_WORD = re.compile(r"\b(?:" + "|".join([*TENS, *UNITS, "hundred", "and", "
 UNIT_AFTER = re.compile(r"^\s*(?:meters?|metres?|m|degrees?|deg|times|centimeters?|centimetres?|cm|steps?)\b")
 
 
+def is_unclear(text: str) -> bool:
+    """Whether a transcript has speech the recogniser could not make out: UNCLEAR as a word of its own, as
+    transcripts write it (a typed "mug…" is not)."""
+    return UNCLEAR in text.split()
+
+
 def normalise(text: str) -> str:
     """Lower case, digits for number words, without punctuation, polite words or the wake word."""
     text = text.lower().replace("’", "'")
