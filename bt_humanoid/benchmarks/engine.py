@@ -41,7 +41,7 @@ def node_count(run) -> int:
 
 
 def bench_compile(leaves: int = 500, repeats: int = 5) -> dict:
-    from bt_humanoid.mission.compiler import Compiler
+    from bt_humanoid.engine.compiler import Compiler
     from bt_humanoid.mission.loader import MissionLoader
 
     mission = generated_mission(leaves, running=False)

@@ -28,7 +28,7 @@ from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite
 from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
-from bt_humanoid.mission.success import check_condition
+from bt_humanoid.engine.verdict import check_condition
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 

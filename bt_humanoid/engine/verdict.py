@@ -1,4 +1,7 @@
-"""A mission's success: conditions checked against the simulator's ground truth at the end."""
+"""The verdict on a mission: its success conditions checked against the simulator's ground truth at the end.
+
+This is judging, not the mission language: only the engine (after a run), tests and evaluation read ground truth.
+"""
 
 from __future__ import annotations
 
