@@ -2,9 +2,9 @@
 
 import pytest
 
+from bt_humanoid.engine.compiler import resolve_recovery
 from bt_humanoid.engine.decorators import RecoverySteps
 from bt_humanoid.language.questions import Answer, Questions, read_answer
-from bt_humanoid.engine.compiler import resolve_recovery
 from bt_humanoid.paths import project_root
 from bt_humanoid.testing.scenario import Scenario, build_run, run_scenario
 

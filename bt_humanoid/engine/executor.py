@@ -15,8 +15,8 @@ from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
 from bt_humanoid.control.robot import RobotController
-from bt_humanoid.engine.events import EventLog
 from bt_humanoid.engine.compiler import CompiledMission
+from bt_humanoid.engine.events import EventLog
 from bt_humanoid.sim.simulation import Simulation
 
 BRAKE_TIMEOUT = 5.0  # s of simulation time allowed to come to rest after the tree ends

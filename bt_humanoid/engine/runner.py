@@ -12,13 +12,13 @@ import numpy as np
 from py_trees.common import Status
 
 from bt_humanoid.control.robot import RobotController
+from bt_humanoid.engine.compiler import CompiledMission, Compiler
 from bt_humanoid.engine.decorators import RecoveryPolicy
 from bt_humanoid.engine.events import EventLog
 from bt_humanoid.engine.executor import Executor
-from bt_humanoid.errors import UserError
-from bt_humanoid.engine.compiler import CompiledMission, Compiler
-from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.engine.verdict import ConditionResult, check_condition
+from bt_humanoid.errors import UserError
+from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import Perceiver

@@ -22,13 +22,13 @@ import numpy as np
 from bt_humanoid.benchmarks.navigation import free_start
 from bt_humanoid.commanding import plan_command
 from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.verdict import check_condition
 from bt_humanoid.evaluation import faults as fault_kinds
 from bt_humanoid.evaluation.scenes import nudge, reachable_spot
 from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite
 from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
-from bt_humanoid.engine.verdict import check_condition
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 
