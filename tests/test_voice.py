@@ -2,8 +2,10 @@
 
 import json
 import re
+import subprocess
 import sys
 import wave
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -11,7 +13,15 @@ import pytest
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, run_main
 from bt_humanoid.commanding import plan_command
 from bt_humanoid.language.asr import CommandRecognizer, command_grammar, frame_power, heard_words, with_noise_floor
-from bt_humanoid.language.audio import espeak_available, read_wav, spoken, synthesize, with_noise, write_wav
+from bt_humanoid.language.audio import (
+    SpeechOut,
+    espeak_available,
+    read_wav,
+    spoken,
+    synthesize,
+    with_noise,
+    write_wav,
+)
 from bt_humanoid.language.listening import END_SILENCE, Listener, heard_in
 from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH
 from bt_humanoid.language.whisper_asr import WhisperRecognizer, world_prompt
@@ -88,6 +98,46 @@ def test_wav_files_of_any_rate_come_out_at_16_khz(tmp_path):
     assert abs(len(samples) - frames * 16000 / rate) <= 1  # the same duration at 16 kHz
     again = read_wav(write_wav(tmp_path / "16k.wav", samples))
     assert np.array_equal(again, samples)
+
+
+def _espeak_from_stdin(text: str, path, *options: str) -> np.ndarray:
+    """What espeak-ng says for ``text`` read from stdin, where it can never be taken as an option."""
+    command = ["espeak-ng", "-v", "en-us", *options, "-w", str(path), "--stdin"]
+    subprocess.run(command, input=text.encode(), check=True)
+    return read_wav(path)
+
+
+def _option_like_texts(folder) -> list[str]:
+    long_file = folder / "long.txt"
+    long_file.write_text("This file is long and must never be read aloud. " * 6)
+    return [f"-w{folder / 'stray.wav'}", "-f/etc/hostname", f"-f{long_file}", f"say -w{folder / 'stray.wav'} now"]
+
+
+def test_text_that_looks_like_espeak_options_is_spoken_as_words(tmp_path):
+    # Before the text went after "--", "-w…" wrote the WAV elsewhere and "-f…" read a file aloud
+    for index, text in enumerate(_option_like_texts(tmp_path)):
+        wav = synthesize(text, tmp_path / f"said{index}.wav")
+        assert wav.exists(), text
+        assert np.array_equal(read_wav(wav), _espeak_from_stdin(text, tmp_path / "reference.wav", "-s", "160")), text
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["long.txt", "reference.wav"] + [
+        f"said{index}.wav" for index in range(4)
+    ]
+
+
+def test_the_speaker_gets_the_text_as_words_too(tmp_path, monkeypatch):
+    commands = []
+    recorder = SimpleNamespace(Popen=lambda command, **_: commands.append(command), DEVNULL=subprocess.DEVNULL)
+    monkeypatch.setattr("bt_humanoid.language.audio.subprocess", recorder)
+    texts = _option_like_texts(tmp_path)
+    speech = SpeechOut(speaker=True)
+    for text in texts:
+        speech(text)
+    for index, (text, command) in enumerate(zip(texts, commands, strict=True)):
+        # the speaker's command line, writing to a file instead of the sound card
+        wav = tmp_path / f"speaker{index}.wav"
+        subprocess.run([command[0], "-w", str(wav), *command[1:]], check=True, capture_output=True)
+        assert np.array_equal(read_wav(wav), _espeak_from_stdin(text, tmp_path / "reference.wav")), text
+    assert not (tmp_path / "stray.wav").exists()
 
 
 def test_bt_run_audio_puts_the_red_cube_on_the_counter(tmp_path, capsys):

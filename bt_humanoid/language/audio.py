@@ -25,15 +25,24 @@ def espeak_available() -> bool:
 
 
 def synthesize(text: str, path: Path, voice: str = "en-us", words_per_minute: int = 160) -> Path:
-    """Speak ``text`` into a WAV file with espeak-ng; a RuntimeError says how to install it if it is missing."""
+    """Speak ``text`` into a WAV file with espeak-ng; a RuntimeError says how to install it if it is missing.
+
+    The text is always words, never options: a ``say`` text (which may come from a language model) of
+    ``-w/some/path`` or ``-f/some/file`` is spoken as written, not obeyed (see ``_espeak_command``).
+    """
     if not espeak_available():
         raise RuntimeError("espeak-ng is not installed (apt-get install espeak-ng, or run scripts/setup.sh)")
     subprocess.run(
-        ["espeak-ng", "-v", voice, "-s", str(words_per_minute), "-w", str(path), text],
+        _espeak_command(text, voice, "-s", str(words_per_minute), "-w", str(path)),
         check=True,
         capture_output=True,
     )
     return path
+
+
+def _espeak_command(text: str, voice: str, *options: str) -> list[str]:
+    """espeak-ng's command line with ``text`` after ``--``, where its option parser (getopt) reads no options."""
+    return ["espeak-ng", "-v", voice, *options, "--", text]
 
 
 def read_wav(path: Path) -> np.ndarray:
@@ -99,4 +108,4 @@ class SpeechOut:
             path = self.folder / f"{len(self.files) + 1:03d}.wav"
             self.files.append(synthesize(text, path, self.voice))
         if self.speaker:
-            subprocess.Popen(["espeak-ng", "-v", self.voice, text], stderr=subprocess.DEVNULL)
+            subprocess.Popen(_espeak_command(text, self.voice), stderr=subprocess.DEVNULL)
