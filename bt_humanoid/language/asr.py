@@ -1,7 +1,7 @@
 """Offline speech recognition: pocketsphinx with a grammar of the robot's commands in this world.
 
 Free dictation with pocketsphinx's general language model is poor on short
-commands (see NOTES.md), so it is only a fallback shown to the person where
+commands (see docs/dependencies.md), so it is only a fallback shown to the person where
 the grammar heard unclear speech (``FreeDictation``). A JSGF grammar of what
 the planner understands, filled with the world's own words (its objects,
 colours, places and surfaces), decodes them reliably and fast. An utterance

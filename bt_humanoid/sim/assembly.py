@@ -112,7 +112,7 @@ def _flatten_frames(parent: ET.Element) -> None:
     """Fold every <frame> into its children's pos/quat.
 
     Pinocchio's MJCF parser silently drops bodies inside <frame> elements
-    (NOTES.md), and MjSpec writes one wherever a spec was attached.
+    (docs/dependencies.md), and MjSpec writes one wherever a spec was attached.
     """
     for child in list(parent):
         _flatten_frames(child)
