@@ -68,7 +68,7 @@ def validate_planned_mission(mission: dict[str, Any], context: PlanningContext) 
     """A planner's mission checked like a file and against the world; PlanRejected says what is wrong."""
     mission = {**mission, "world": context.world.name, "robot": context.robot}
     try:
-        MissionLoader().load_data(mission, name="<plan>")
+        MissionLoader.for_plans().load_data(mission, name="<plan>")
     except UserError as error:
         raise PlanRejected(str(error)) from None
     for problem in _world_problems(mission["tree"], context):
@@ -138,7 +138,7 @@ def plan_command(
         plan = planner.answer(plan.choice, reply, context)
     spec = None
     if plan.kind == "mission" and plan.mission is not None:
-        spec = MissionLoader().load_data(plan.mission, name="<command>")
+        spec = MissionLoader.for_plans().load_data(plan.mission, name="<command>")
     return CommandOutcome(plan, spec)
 
 

@@ -25,6 +25,14 @@ def display_path(path: Path) -> str:
         return str(path)
 
 
+def step_name(path: YamlPath) -> str:
+    """A path of keys and indices as one would write it: ``tree.sequence[1].pick``."""
+    text = ""
+    for part in path:
+        text += f"[{part}]" if isinstance(part, int) else f"{'.' if text else ''}{part}"
+    return text
+
+
 @dataclass
 class YamlSource:
     """Parsed YAML data plus the line of every value (by path of keys and indices)."""
@@ -34,7 +42,10 @@ class YamlSource:
     lines: dict[YamlPath, int] = field(default_factory=dict)
 
     def where(self, path: YamlPath) -> str:
-        """'file:line' of the value at ``path``, or of its nearest ancestor."""
+        """'file:line' of the value at ``path``, or of its nearest ancestor; for data with no file (a planner's
+        mission, named like ``<plan>``), the step: ``<plan> at tree.sequence[1].pick.object``."""
+        if not self.lines and self.file.name.startswith("<"):
+            return f"{self.file.name} at {step_name(path)}" if path else self.file.name
         probe = tuple(path)
         while probe and probe not in self.lines:
             probe = probe[:-1]

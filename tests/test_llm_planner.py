@@ -5,6 +5,7 @@ repair, and after too many the embedded planner answers. A cache spares repeated
 """
 
 import json
+import os
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
@@ -14,7 +15,9 @@ from bt_humanoid.cli import EXIT_OK, plan_main
 from bt_humanoid.commanding import make_planner
 from bt_humanoid.language.llm import LlmSettings, PlanCache, world_summary
 from bt_humanoid.language.plan import PlanningContext, mission_signature
+from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.testing.told import told_planning_context
+from bt_humanoid.yaml_source import display_path
 
 GOOD = {"kind": "mission", "say": "I will fetch the mug.", "tree": {"take": {"object": "coffee mug"}}}
 UNKNOWN_SKILL = {"kind": "mission", "say": "Backflip!", "tree": {"backflip": {"height": 2}}}
@@ -118,6 +121,31 @@ def test_an_unreachable_endpoint_falls_back_with_the_reason(context):
     plan = planner.plan("turn left ninety degrees", context)
     assert plan.kind == "mission" and mission_signature(plan.mission["tree"]) == ["turn 90"]
     assert "planned offline: the language model at http://127.0.0.1:9/v1 failed" in plan.say
+
+
+def _waving_with(file: str) -> dict:
+    return {
+        "kind": "mission",
+        "say": "Waving.",
+        "tree": {"sequence": [{"say": {"text": "Hi"}}, {"subtree": {"file": file}}]},
+    }
+
+
+def test_a_plan_calls_subtree_files_only_from_the_behaviour_folder(model, context, tmp_path):
+    # Before: a plan could name any file; a valid behaviour outside behaviors/ was loaded and run
+    outside = tmp_path / "wave.yaml"
+    outside.write_text((behaviors_dir() / "wave.yaml").read_text())
+    for file in (str(outside), os.path.relpath(outside, behaviors_dir()), "../../../../../../etc/passwd"):
+        model.answers(_waving_with(file), GOOD)
+        plan = _planner(model).plan("wave", context)
+        assert len(model.requests) == 2 and mission_signature(plan.mission["tree"]) == ["take coffee mug"], file
+        feedback = model.requests[1]["messages"][-1]["content"]
+        where = "<plan> at tree.sequence[1].subtree.file"
+        assert f"{where}: subtree file '{file}' is outside {display_path(behaviors_dir())}/" in feedback, feedback
+        assert "valid: approach.yaml, fetch.yaml" in feedback and "wave.yaml" in feedback
+    model.answers(_waving_with("wave.yaml"))  # a behaviour of the project's own, by its file: fine
+    plan = _planner(model).plan("wave", context)
+    assert len(model.requests) == 1 and plan.mission["tree"]["sequence"][1] == {"subtree": {"file": "wave.yaml"}}
 
 
 def test_a_repeated_command_comes_from_the_cache(model, context):

@@ -6,10 +6,13 @@ import numpy as np
 import pytest
 import yaml
 
+from bt_humanoid.commanding import plan_command
+from bt_humanoid.errors import UserError
 from bt_humanoid.language.embedded import EmbeddedPlanner, split_clauses
-from bt_humanoid.language.plan import PlanningContext, mission_signature, plan_outcome
+from bt_humanoid.language.plan import Plan, PlanningContext, mission_signature, plan_outcome
 from bt_humanoid.language.words import normalise
 from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.testing.told import told_planning_context
 
 COMMANDS = yaml.safe_load((Path(__file__).parent / "data" / "commands.yaml").read_text())
@@ -61,6 +64,23 @@ def test_every_planned_mission_is_valid_in_the_mission_language(planner, context
     plan = planner.plan(command["text"], context)
     assert plan.kind == "mission", plan.say
     MissionLoader().load_data(plan.mission)  # raises a UserError naming the step if not
+
+
+def test_a_planned_mission_is_loaded_with_subtree_files_only_from_the_behaviour_folder(context, tmp_path):
+    outside = tmp_path / "wave.yaml"
+    outside.write_text((behaviors_dir() / "wave.yaml").read_text())  # a valid behaviour, outside behaviors/
+
+    class Planner:  # any planner, e.g. one that was fooled; plan_command loads what it answers
+        def __init__(self, file: str) -> None:
+            self.file = file
+
+        def plan(self, text, context):
+            return Plan("mission", "Waving.", mission={"mission": text, "tree": {"subtree": {"file": self.file}}})
+
+    with pytest.raises(UserError) as refused:
+        plan_command("wave", context, lambda _: None, Planner(str(outside)))
+    assert str(refused.value).startswith(f"<command> at tree.subtree.file: subtree file '{outside}' is outside")
+    assert plan_command("wave", context, lambda _: None, Planner("wave.yaml")).spec is not None
 
 
 def test_the_answer_to_a_question_continues_the_command(planner, context):

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from bt_humanoid.cli import validate_main
+from bt_humanoid.errors import UserError
 
 
 def write(tmp_path: Path, name: str, text: str) -> Path:
@@ -122,6 +123,18 @@ def test_missing_subtree_file(tmp_path, capsys):
     code, err = validate(capsys, path)
     assert code == 2
     assert "m.yaml:4" in err and "subtree file not found" in err and "pick.yaml" in err
+
+
+def test_a_mission_file_calls_subtree_files_of_its_own_and_a_plan_may_not(tmp_path):
+    from bt_humanoid.mission.loader import MissionLoader
+
+    mission = write(tmp_path, "m.yaml", "mission: mine\ntree: {subtree: {file: ../wave.yaml, args: {times: 1}}}\n")
+    wave = (Path(__file__).parent.parent / "behaviors" / "wave.yaml").read_text()
+    (tmp_path.parent / "wave.yaml").write_text(wave)  # the person's own behaviour, beside their folder
+    assert MissionLoader().load_file(mission).tree.children[0].kind == "sequence"
+    with pytest.raises(UserError) as refused:
+        MissionLoader.for_plans().load_file(mission)
+    assert "m.yaml:2: subtree file '../wave.yaml' is outside" in str(refused.value)
 
 
 def test_recursive_subtree(tmp_path, capsys):

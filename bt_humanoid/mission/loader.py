@@ -9,7 +9,7 @@ as a UserError naming the place and what would be valid.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, get_args
 
@@ -28,6 +28,7 @@ from bt_humanoid.mission.schema import (
     structural_kinds,
 )
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
+from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.sim.assembly import joint_ranges
 from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.world_config import load_world_config
@@ -65,10 +66,23 @@ MAX_TREE_DEPTH = 64  # levels of nodes: far beyond any real mission, well inside
 class MissionLoader:
     """Loads missions against the skill registry, a behaviour library and the named robot and world."""
 
-    def __init__(self, library: BehaviorLibrary | None = None, check_world: bool = True) -> None:
+    def __init__(
+        self,
+        library: BehaviorLibrary | None = None,
+        check_world: bool = True,
+        subtree_roots: Sequence[Path] | None = None,
+    ) -> None:
         self.library = library or BehaviorLibrary()
         # False when checking a behaviour on its own: its arguments are placeholders then
         self.check_world = check_world
+        # None: a subtree file is any file, relative to the one calling it (a person's own mission files).
+        # Folders: subtree files must lie inside one of them (a planner's missions: only the project's behaviours).
+        self.subtree_roots = None if subtree_roots is None else [Path(root).resolve() for root in subtree_roots]
+
+    @classmethod
+    def for_plans(cls) -> MissionLoader:
+        """The loader for missions a planner wrote: subtree files only from the project's behaviors/ folder."""
+        return cls(subtree_roots=[behaviors_dir()])
 
     # --- entry points ------------------------------------------------------------
 
@@ -219,13 +233,16 @@ class MissionLoader:
         return self._expand(kind, behavior.source, args.model_dump(), source, bpath, node_path, stack, spec)
 
     def _subtree_file(self, settings, source, bpath, node_path, stack, spec) -> NodeSpec:
-        file = (source.file.parent / settings.file).resolve()
-        if not file.is_file():
-            raise UserError(
-                f"subtree file not found: {display_path(file)}",
-                where=source.where((*bpath, "file")),
-                hint="paths are relative to the file that calls them",
-            )
+        if self.subtree_roots is None:
+            file = (source.file.parent / settings.file).resolve()
+            if not file.is_file():
+                raise UserError(
+                    f"subtree file not found: {display_path(file)}",
+                    where=source.where((*bpath, "file")),
+                    hint="paths are relative to the file that calls them",
+                )
+        else:
+            file = self._confined_subtree(settings.file, source, bpath)
         from bt_humanoid.mission.behaviors import load_behavior
 
         behavior = load_behavior(file)
@@ -234,6 +251,28 @@ class MissionLoader:
         except ValidationError as error:
             raise source.invalid(error, (*bpath, "args"), prefix=f"subtree {behavior.name}: ") from None
         return self._expand(behavior.name, behavior.source, args.model_dump(), source, bpath, node_path, stack, spec)
+
+    def _confined_subtree(self, name: str, source: YamlSource, bpath: YamlPath) -> Path:
+        """A subtree file inside the allowed folders: relative to the calling file when that lies inside one
+        (a behaviour calling another), else to the first folder (a plan names ``pick.yaml``)."""
+        roots = self.subtree_roots or []
+        caller = source.file.resolve().parent
+        base = caller if any(caller.is_relative_to(root) for root in roots) else roots[0]
+        file = (base / name).resolve()  # symbolic links resolved: a link out of the folder is outside it
+        if any(file.is_relative_to(root) for root in roots) and file.is_file():
+            return file
+        valid = sorted(str(path.relative_to(roots[0])) for path in roots[0].rglob("*.yaml"))
+        valid += sorted(display_path(path) for root in roots[1:] for path in root.rglob("*.yaml"))
+        folders = " or ".join(f"{display_path(root)}/" for root in roots)
+        if any(file.is_relative_to(root) for root in roots):
+            problem = f"not found in {folders}"
+        else:
+            problem = f"outside {folders}: a planned mission may call only the project's behaviours"
+        raise UserError(
+            f"subtree file '{name}' is {problem}",
+            where=source.where((*bpath, "file")),
+            hint=f"valid: {', '.join(valid)}; or call a behaviour by name, e.g. pick: {{object: red cube}}",
+        )
 
     def _expand(self, name, behavior_source, args, call_source, bpath, node_path, stack, spec) -> NodeSpec:
         if name in stack:
