@@ -256,8 +256,9 @@ class MissionLoader:
         """A subtree file inside the allowed folders: relative to the calling file when that lies inside one
         (a behaviour calling another), else to the first folder (a plan names ``pick.yaml``)."""
         roots = self.subtree_roots or []
-        caller = source.file.resolve().parent
-        base = caller if any(caller.is_relative_to(root) for root in roots) else roots[0]
+        caller = source.file.resolve().parent  # a plan's "file" (<plan>) is no file: its folder is no base
+        inside = not source.file.name.startswith("<") and any(caller.is_relative_to(root) for root in roots)
+        base = caller if inside else roots[0]
         file = (base / name).resolve()  # symbolic links resolved: a link out of the folder is outside it
         if any(file.is_relative_to(root) for root in roots) and file.is_file():
             return file
