@@ -13,7 +13,7 @@ import pytest
 
 from bt_humanoid.cli import EXIT_OK, plan_main
 from bt_humanoid.commanding import make_planner
-from bt_humanoid.language.llm import LlmSettings, PlanCache, world_summary
+from bt_humanoid.language.llm import MAX_REPLY_BYTES, LlmSettings, PlanCache, world_summary
 from bt_humanoid.language.plan import PlanningContext, mission_signature
 from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.testing.told import told_planning_context
@@ -146,6 +146,18 @@ def test_a_plan_calls_subtree_files_only_from_the_behaviour_folder(model, contex
     model.answers(_waving_with("wave.yaml"))  # a behaviour of the project's own, by its file: fine
     plan = _planner(model).plan("wave", context)
     assert len(model.requests) == 1 and plan.mission["tree"]["sequence"][1] == {"subtree": {"file": "wave.yaml"}}
+
+
+def test_a_reply_over_the_size_limit_is_not_read_and_the_embedded_planner_answers(model, context):
+    # Before the limit, the whole reply was read into memory, however large, and this plan was used
+    padding = MAX_REPLY_BYTES - len(json.dumps(GOOD))
+    model.answers({**GOOD, "say": "x" * (padding - 200)})  # just under the limit, with the reply's wrapping: read
+    assert _planner(model).plan("bring the mug", context).say.startswith("xxx")
+    model.answers({**GOOD, "say": "x" * padding})
+    plan = _planner(model).plan("pick up the red cube", context)
+    assert len(model.requests) == 1 and mission_signature(plan.mission["tree"]) == ["take red cube"]
+    limit = f"{MAX_REPLY_BYTES:,}"
+    assert f"(planned offline: the language model at {model.url} failed: its reply is larger than {limit}" in plan.say
 
 
 def test_a_repeated_command_comes_from_the_cache(model, context):
