@@ -45,3 +45,17 @@ def test_a_bottle_trial_is_picked_and_placed_upright_and_judged_so():
     assert outcome.grasped and outcome.placed, outcome.failure
     assert outcome.error_cm < 3.0
     assert len(outcome.qp_times) > 100  # the whole-body QP ran and was timed at every control step
+
+
+def test_the_table_says_what_each_rate_is_counted_over():
+    from bt_humanoid.benchmarks.manipulation import Outcome, Trial, summarize, table
+
+    trial = Trial("mug", "west", (2.9, 0.1), 0.0, (2.9, -0.1), (2.2, 0.0, 0.0))
+
+    def outcome(grasped: bool, placed: bool) -> Outcome:
+        return Outcome(grasped, placed, 0.3 if placed else None, None if placed else "missed", 10.0, [], [])
+
+    outcomes = [outcome(True, True)] * 3 + [outcome(True, False), outcome(False, False)]
+    header, row = table([summarize("mug", [trial] * 5, outcomes)]).splitlines()
+    assert "grasp | of all" in header and "place | of grasped" in header and "place | of all" in header
+    assert "4/5 80%" in row and "3/4 75%" in row and "3/5 60%" in row

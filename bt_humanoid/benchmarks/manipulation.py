@@ -9,7 +9,10 @@ starts 0.3 m behind that edge's stance, and the mission is the `pick` and
 edge. The objects not in play wait on the counter. Success is judged in ground
 truth: a grasp when the pick ends with the object in the hand; a placement
 when it rests on the table within 3 cm of the spot (and upright, for things
-kept upright). Also prints the whole-body QP time per control step. The
+kept upright). Rates say what they are counted over: grasps of all trials,
+placements of the grasped trials (a trial that never held the object is not
+a placement attempt) and of all trials. Also prints the whole-body QP time
+per control step. The
 robot finds the object with its head camera; ``--perception told`` tells it
 where the object is instead, to measure control alone. Runs pinned to one
 CPU core; ``--json PATH`` also writes the figures.
@@ -174,14 +177,31 @@ def summarize(kind: str, trials: list[Trial], outcomes: list[Outcome]) -> dict:
     return {
         "kind": kind,
         "trials": len(outcomes),
-        "grasp_success": len(grasped) / len(outcomes),
-        "place_success": len(placed) / len(grasped) if grasped else 0.0,
-        "end_to_end": len(placed) / len(outcomes),
-        "median_place_error_cm": statistics.median(errors) if errors else None,
+        "grasped": len(grasped),
+        "placed": len(placed),
+        "grasp_success": len(grasped) / len(outcomes),  # of all trials
+        "place_success": len(placed) / len(grasped) if grasped else 0.0,  # of the grasped trials
+        "end_to_end": len(placed) / len(outcomes),  # placed, of all trials
+        "median_place_error_cm": statistics.median(errors) if errors else None,  # over the placed trials
         "failures": [
             {"trial": asdict(t), "failure": o.failure} for t, o in zip(trials, outcomes, strict=True) if not o.placed
         ],
     }
+
+
+def table(summaries: list[dict]) -> str:
+    """The per-kind rates, each headed by what it is counted over (placements: of the grasped trials, and of all)."""
+    lines = [
+        f"  {'kind':8} {'trials':>6} {'grasp | of all':>16} {'place | of grasped':>20} {'place | of all':>16} "
+        f"{'median error | of placed':>26}"
+    ]
+    for s in summaries:
+        error = f"{s['median_place_error_cm']:.1f} cm" if s["median_place_error_cm"] is not None else "-"
+        grasp = f"{s['grasped']}/{s['trials']} {s['grasp_success']:.0%}"
+        place = f"{s['placed']}/{s['grasped']} {s['place_success']:.0%}"
+        overall = f"{s['placed']}/{s['trials']} {s['end_to_end']:.0%}"
+        lines.append(f"  {s['kind']:8} {s['trials']:>6} {grasp:>16} {place:>20} {overall:>16} {error:>26}")
+    return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -228,13 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         "wall_s": round(time.perf_counter() - started, 1),
     }
     print()
-    print(f"  {'kind':8} {'trials':>6} {'grasp':>7} {'place':>7} {'end-to-end':>11} {'median error':>13}")
-    for s in summaries:
-        error = f"{s['median_place_error_cm']:.1f} cm" if s["median_place_error_cm"] is not None else "-"
-        print(
-            f"  {s['kind']:8} {s['trials']:>6} {s['grasp_success']:>7.0%} {s['place_success']:>7.0%} "
-            f"{s['end_to_end']:>11.0%} {error:>13}"
-        )
+    print(table(summaries))
     print(
         f"  whole-body QP per control step: median {figures['qp_median_ms']:.3f} ms, "
         f"p95 {figures['qp_p95_ms']:.3f} ms over {figures['qp_steps']} steps (target ≤ 0.5 ms); "
