@@ -177,16 +177,16 @@ def test_the_ray_backend_runs_episodes_on_a_local_ray_instance():
     assert records[0]["success"], records[0]["failure"]
 
 
-def test_the_readme_results_section_is_generated_from_the_committed_run():
+def test_the_results_section_in_docs_is_generated_from_the_committed_run():
     from bt_humanoid.evaluation.report import markdown
 
     root = BENCHMARKS.parents[1]
     saved = json.loads((root / "results" / "fetch-seed0.json").read_text())
-    readme = (root / "README.md").read_text()
+    results = (root / "docs" / "results.md").read_text()
     begin, end = (
         "<!-- results:fetch:begin (bt-eval results/fetch-seed0.json --markdown) -->\n",
         "<!-- results:fetch:end -->",
     )
-    section = readme[readme.index(begin) + len(begin) : readme.index(end)]
+    section = results[results.index(begin) + len(begin) : results.index(end)]
     assert section == markdown(saved, saved["command"])
     assert len(saved["episodes"]) == saved["success"]["episodes"] >= 200
