@@ -31,7 +31,8 @@ PLACEHOLDER = re.compile(r"[*?{}<>$…]|\.\.\.|(?:^|/)[A-Z][A-Z0-9_]*(?:/|$)")
 
 def tracked_text_files() -> list[Path]:
     listed = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
-    return [ROOT / name for name in listed.split("\0") if name and Path(name).suffix in SCANNED]
+    files = [ROOT / name for name in listed.split("\0") if name and Path(name).suffix in SCANNED]
+    return [path for path in files if path != Path(__file__).resolve()]  # this file's examples are not references
 
 
 def references(text: str, markdown: bool = True) -> set[str]:
