@@ -31,8 +31,8 @@ import numpy as np
 
 from bt_humanoid.language.audio import RATE, with_noise
 from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, write_dictionary
-from bt_humanoid.language.words import UNCLEAR, WAKE_WORDS, is_unclear
-from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS
+from bt_humanoid.language.vocabulary import INTENTS, SAY_PHRASES, WorldVocabulary
+from bt_humanoid.language.words import AFTER, POLITE_SPOKEN, UNCLEAR, WAKE_WORDS, is_unclear
 from bt_humanoid.sim.world_config import WorldConfig
 
 if TYPE_CHECKING:
@@ -93,21 +93,26 @@ class Transcript:
 
 
 def command_grammar(world: WorldConfig) -> str:
-    """A JSGF grammar of the commands the embedded planner understands, in this world's words."""
-    names = sorted(world.objects)
-    kinds = sorted({w for w in KIND_WORDS if not w.endswith("s")} | {"thing"})
-    plurals = sorted(w for w in KIND_WORDS if w.endswith("s") and w[:-1] in KIND_WORDS)
-    colours = sorted(c for c in COLOURS if c != "gray")
-    places = sorted(p.replace("_", " ") for p in world.places if p != "start")
-    surfaces = sorted(world.surfaces)
+    """A JSGF grammar of the commands the embedded planner understands, in this world's words.
+
+    Its verbs are the spoken verbs of ``vocabulary.INTENTS`` (the planner's phrasings are built from the same
+    table), its names every name and alias world.yaml gives an object, place or surface.
+    """
+    words = WorldVocabulary.of(world)
+    names = sorted(words.objects)
+    home = {w for w, place in words.places.items() if place == "start"}  # "go home" says it
+    places = sorted(set(words.places) - home)
+    surfaces = sorted(words.surfaces)
     unmovable = sorted({"person", *places, *surfaces})
     rule = " | ".join
+    verbs = {name: intent.rule() for name, intent in INTENTS.items() if intent.spoken}
+    after = " ".join(f"[{word}]" for word in AFTER)
     return "\n".join(
         [
             "#JSGF V1.0;",
             "grammar robot;",
-            f"public <utterance> = [{' | '.join(SPOKEN_WAKE_WORDS)}] [<polite>] <command> [please] [now];",
-            "<polite> = please | could you | can you | would you;",
+            f"public <utterance> = [{' | '.join(SPOKEN_WAKE_WORDS)}] [<polite>] <command> {after};",
+            f"<polite> = {rule(POLITE_SPOKEN)};",
             # Steps are joined by a word, as in "A and B" or "A then B". A command of steps side by side ("where is
             # the mug" as "wave lift the mug") was the commonest misreading; a spoken comma is heard as "and".
             # The rule loops (right recursion), so the grammar holds one copy of a step, not one per position.
@@ -115,28 +120,27 @@ def command_grammar(world: WorldConfig) -> str:
             "<next> = (and | then | and then) <clause> [<next>];",
             "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>"
             " | <unclear>;",
-            "<take> = (pick up | grab | take | get | lift | collect) (<object> | the <unmovable>) | pick <object> up;",
-            "<put> = (put | place | set) <thing> [down] (on | onto) <surface> | (move | take | carry) <thing> [over] to"
-            " <surface>;",
-            "<bring> = (bring | fetch | give | hand | get) me <object> | (bring | take | carry) <thing> to me;",
-            "<go> = (go | walk | drive | head | navigate) [over] to (<place> | <object>) | go home | come here"
-            " | come to me;",
-            "<step> = (walk | go | move | drive) (forward | back | backward) [<number> (meters | meter)];",
-            "<turn> = (turn | rotate) (left | right) [<number> degrees] | turn around | face <place>;",
-            "<find> = (find | where is | look for) <object>;",
-            "<wave> = wave [<number> times];",
-            "<stop> = stop | halt | freeze;",
-            "<say> = say (hello [everyone] | goodbye | done | thank you);",
+            f"<take> = {verbs['take']} (<object> | the <unmovable>) | pick <object> up;",
+            f"<put> = {verbs['put']} <thing> [down] (on | onto) <surface>"
+            f" | {verbs['carry_to_surface']} <thing> [over] to <surface>;",
+            f"<bring> = {verbs['bring_me']} me <object> | {verbs['carry_to_person']} <thing> to me;",
+            f"<go> = {verbs['go']} [over] to (<place> | <object>) | {verbs['go_home']} | {verbs['come']};",
+            f"<step> = {verbs['step']} (forward | back | backward) [<number> (meters | meter)];",
+            f"<turn> = {verbs['turn']} (left | right) [<number> degrees] | turn around | {verbs['face']} <place>;",
+            f"<find> = {verbs['find']} <object>;",
+            f"<wave> = {verbs['wave']} [<number> times];",
+            f"<stop> = {verbs['stop']};",
+            f"<say> = {verbs['say']} ({rule(SAY_PHRASES)});",
             "<thing> = <object> | it | them | all the [<colour>] <plural> | both [<colour>] <plural>;",
             "<object> = the <description> | something to (drink | play with) | the <unclear>;",
             "<description> = [<colour>] <kind> [(on | from) <surface>] [in <place>] | <name>"
             " | (biggest | smallest) thing;",
             f"<name> = {rule(names)};",
             f"<unmovable> = {rule(unmovable)};  // the planner refuses these with a reason",
-            f"<kind> = {rule(kinds)};",
-            f"<plural> = {rule(plurals)};",
-            f"<colour> = {rule(colours)};",
-            f"<surface> = the [kitchen | dining] ({rule(surfaces)}) | the <unclear>;",
+            f"<kind> = {rule([*words.kinds, 'thing'])};",
+            f"<plural> = {rule(words.plurals)};",
+            f"<colour> = {rule(words.colours)};",
+            f"<surface> = the ({rule(surfaces)}) | the <unclear>;",
             f"<place> = the ({rule(places)}) | <surface>;",
             f"<number> = {NUMBERS};",
             # Words the robot does not know, where people say them: a step ("make me a sandwich"), an object

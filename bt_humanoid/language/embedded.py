@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
+from bt_humanoid.language.vocabulary import INTENTS, WorldVocabulary, every_verb
 from bt_humanoid.language.words import normalise
 from bt_humanoid.perception.free_space import free_spot
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS, describes_an_object, ground
@@ -44,76 +45,69 @@ DEFAULT_TURN = 90.0  # degrees for "turn left" without a number
 DEFAULT_STEP = 1.0  # m for "walk forward" without a number
 MAX_STEP = 5.0  # m: a longer relative move is a job for "go to"
 PERSON_WORDS = {"me", "us", "the user", "user", "the person", "person", "here"}
-PLACE_ALIASES = {"home": "start", "dining table": "table", "kitchen counter": "counter", "shelves": "shelf"}
 CLAUSE_BREAK = re.compile(r"\s*(?:,\s*)?(?:\band then\b|\bthen\b|\bafter that\b|\band\b|,)\s*")
 ARTICLE = re.compile(r"^(?:the|a|an|some|my|your|that|this)\s+")
 
-VERB = r"(?:pick|grab|take|get|lift|grasp|collect|put|place|set|drop|leave|bring|fetch|hand|give|pass|carry|go|walk|"
-VERB += r"drive|move|head|navigate|come|return|turn|rotate|spin|face|find|look|search|locate|where|show|say|tell|"
-VERB += r"announce|wave|stop|halt|freeze|back|step)\b"
+VERB = "(?:" + "|".join(re.escape(verb) for verb in every_verb()) + r")\b"
 STARTS_WITH_VERB = re.compile(rf"^{VERB}")
 
-STOP = re.compile(r"^(?:stop|halt|freeze|stand still|abort|cancel)\b")
+
+def _verbs(*intents: str) -> str:
+    """The verbs of some intents (vocabulary.py) as one alternation, longest first."""
+    verbs = sorted({verb for intent in intents for verb in INTENTS[intent].verbs}, key=len, reverse=True)
+    return "(?:" + "|".join(re.escape(verb) for verb in verbs) + ")"
+
+
+STOP = re.compile(rf"^{_verbs('stop')}\b")
+# Each kind of step, by its verbs (the one vocabulary, shared with the speech grammar) and what follows them
 PATTERNS: list[tuple[str, re.Pattern[str]]] = [
     ("stop", STOP),
-    ("say", re.compile(r"^(?:say|tell (?:me|us|them|everyone)|announce)\s+(?P<text>.+)$")),
-    ("wave", re.compile(r"^wave\b(?:.*?\b(?P<times>\d+)\s+times)?")),
+    ("say", re.compile(rf"^{_verbs('say')}\s+(?P<text>.+)$")),
+    ("wave", re.compile(rf"^{_verbs('wave')}\b(?:.*?\b(?P<times>\d+)\s+times)?")),
     (
         "step",
         re.compile(
-            r"^(?:walk|go|move|drive|step|roll|come|back up|head)\s+(?P<dir>forwards?|ahead|straight|back|backwards?)"
+            rf"^{_verbs('step')}\s+(?P<dir>forwards?|ahead|straight|back|backwards?)"
             r"(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?P<unit>meters?|metres?|m|centimeters?|centimetres?|cm|steps?))?$"
         ),
     ),
-    ("back_up", re.compile(r"^back up(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?P<unit>meters?|metres?|m|cm))?$")),
+    ("back_up", re.compile(rf"^{_verbs('back_up')}(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?P<unit>meters?|metres?|m|cm))?$")),
     (
         "turn",
         re.compile(
-            r"^(?:turn|rotate|spin)\s+(?:to (?:the|your)\s+)?(?P<dir>left|right|around)"
+            rf"^{_verbs('turn')}\s+(?:to (?:the|your)\s+)?(?P<dir>left|right|around)"
             r"(?:\s+(?:by\s+)?(?P<n>[\d.]+)\s*(?:degrees?|deg))?$"
         ),
     ),
-    ("face", re.compile(r"^(?:turn to face|face|turn towards?|look towards?)\s+(?P<where>.+)$")),
-    (
-        "bring_me",
-        re.compile(r"^(?:bring|fetch|get|hand|give|pass)\s+(?:me|us)\s+(?P<what>.+)$"),
-    ),
+    ("face", re.compile(rf"^{_verbs('face')}\s+(?P<where>.+)$")),
+    ("bring_me", re.compile(rf"^{_verbs('bring_me')}\s+(?:me|us)\s+(?P<what>.+)$")),
     (
         "bring_to",
         re.compile(
-            r"^(?:bring|fetch|get|hand|give|pass|take|carry|move)\s+(?P<what>.+?)\s+"
+            rf"^{_verbs('carry_to_surface', 'carry_to_person')}\s+(?P<what>.+?)\s+"
             r"(?:over\s+)?(?:to|onto|over to|into|back to)\s+(?P<where>.+)$"  # "on the table" says where it is
         ),
     ),
-    ("bring_me", re.compile(r"^(?:bring|fetch)\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
+    ("bring_me", re.compile(rf"^{_verbs('bring_here')}\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
     (
         "put",
         re.compile(
-            r"^(?:put|place|set|drop|leave|stack)\s+(?:down\s+)?(?P<what>.+?)\s+(?:down\s+)?"
+            rf"^{_verbs('put')}\s+(?:down\s+)?(?P<what>.+?)\s+(?:down\s+)?"
             r"(?:on top of|onto|on|into|in)\s+(?P<where>.+)$"
         ),
     ),
-    ("put_down", re.compile(r"^(?:put|place|set|drop)\s+(?:down\s+)?(?P<what>.+?)(?:\s+down)?$")),
-    ("come", re.compile(r"^(?:come|come here|come over here|come back|come to me|return to me)$")),
+    ("put_down", re.compile(rf"^{_verbs('put')}\s+(?:down\s+)?(?P<what>.+?)(?:\s+down)?$")),
+    ("come", re.compile(rf"^{_verbs('come')}$")),
     (
         "go",
         re.compile(
-            r"^(?:go|walk|drive|move|head|navigate|come|return|get)\s+(?:back\s+)?(?:over\s+)?"
+            rf"^{_verbs('go')}\s+(?:back\s+)?(?:over\s+)?"
             r"(?:to|into|in|towards?|inside)\s+(?P<where>.+)$"
         ),
     ),
-    ("go_home", re.compile(r"^(?:go|come|return)\s+(?:back\s+)?home$")),
-    (
-        "find",
-        re.compile(
-            r"^(?:find|look for|search for|locate|where is|where's|where are|look at|show me|can you see|do you see)"
-            r"\s+(?P<what>.+?)$"
-        ),
-    ),
-    (
-        "pick",
-        re.compile(r"^(?:pick up|pick|grab|take|get|lift|grasp|collect|hold)\s+(?P<what>.+?)(?:\s+up)?$"),
-    ),
+    ("go_home", re.compile(rf"^{_verbs('go_home')}$")),
+    ("find", re.compile(rf"^{_verbs('find')}\s+(?P<what>.+?)$")),
+    ("pick", re.compile(rf"^{_verbs('take')}\s+(?P<what>.+?)(?:\s+up)?$")),
 ]
 
 
@@ -270,7 +264,7 @@ class EmbeddedPlanner:
             state.steps.append({"navigate": {"place": place}})
             state.lines.append(f"go to the {_spoken(place)}")
             return
-        if describes_an_object(where, list(context.world.objects)):
+        if describes_an_object(where, list(WorldVocabulary.of(context.world).objects)):
             target = self._one_object(match["where"], state, context)
             key = _key(target)
             state.steps.append({"find": {"object": target, "remember_as": key}})
@@ -325,8 +319,8 @@ class EmbeddedPlanner:
         state.lines.append("come to you")
 
     def _put_on(self, what: str, where: str, state: _State, context: PlanningContext) -> None:
-        surface_name = _bare(where)
-        surface_name = PLACE_ALIASES.get(surface_name, surface_name)
+        words = _bare(where)
+        surface_name = WorldVocabulary.of(context.world).surface(words) or words
         if surface_name not in context.world.surfaces:
             surfaces = ", the ".join(context.world.surfaces)
             raise PlanRefused(f"I can't put things on '{surface_name}'. I can put them on the {surfaces}.")
@@ -370,6 +364,9 @@ class EmbeddedPlanner:
 
     def _one_object(self, phrase: str, state: _State, context: PlanningContext) -> str:
         bare = _bare(phrase)
+        canonical = WorldVocabulary.of(context.world).object(bare)
+        if canonical is not None:  # a name the world gives it, or an alias ("tea caddy" for the tea tin)
+            phrase = bare = canonical
         if bare in ("it", "that", "this"):
             return self._objects(bare, state, context)[0]
         if bare in PERSON_WORDS or bare in context.world.person_names:
@@ -515,12 +512,8 @@ def _bare(phrase: str) -> str:
 
 
 def _place_name(words: str, context: PlanningContext) -> str | None:
-    """A named place from spoken words: "living room" is living_room; "home" the start."""
-    key = words.replace(" ", "_")
-    if key in context.world.places:
-        return key
-    alias = PLACE_ALIASES.get(words)
-    return alias if alias in context.world.places else None
+    """A named place from spoken words: "living room" is living_room, "dining table" (an alias) the table."""
+    return WorldVocabulary.of(context.world).place(words)
 
 
 def _spoken(name: str) -> str:

@@ -12,7 +12,11 @@ import re
 
 UNCLEAR = "…"  # stands in a transcript for speech the recogniser could not make out ("bring me the …")
 WAKE_WORDS = ("hey robot", "ok robot", "okay robot", "robot")
-POLITE = ("please", "could you", "can you", "would you", "will you", "i want you to", "i would like you to")
+# Polite words around a command, left out before planning. The speech grammar hears the spoken ones before a
+# command, and AFTER ones at its end ("turn left please", "go home now"); typed, any of them go anywhere.
+POLITE_SPOKEN = ("please", "could you", "can you", "would you")
+POLITE = (*POLITE_SPOKEN, "will you", "i want you to", "i would like you to")
+AFTER = ("please", "now")
 
 UNITS = {
     "zero": 0,
@@ -62,6 +66,7 @@ def normalise(text: str) -> str:
             break
     for polite in POLITE:
         text = re.sub(rf"\b{polite}\b", " ", text)
+    text = re.sub(rf"(?:\s+(?:{'|'.join(AFTER)}))+\s*$", "", " " + " ".join(text.split()))  # "… now" at the end
     text = " ".join(text.split()).strip(" ,")
     return _digits(text)
 

@@ -16,15 +16,20 @@ Pose2D = tuple[float, float, float]  # x [m], y [m], yaw [deg]
 Region = tuple[tuple[float, float], tuple[float, float]]
 
 
+ALIASES = "other names people call it by, in commands typed or spoken (English words the recogniser knows)"
+
+
 class Place(StrictModel):
     pose: Pose2D
     region: Region | None = None
     kind: Literal["room", "furniture", "spot"] = "spot"
+    aliases: list[str] = Field(default_factory=list, description=ALIASES)
 
 
 class Surface(StrictModel):
     geom: str
     place: str
+    aliases: list[str] = Field(default_factory=list, description=ALIASES)
 
 
 class WorldObject(StrictModel):
@@ -32,6 +37,7 @@ class WorldObject(StrictModel):
     kind: str
     colour: str
     upright: bool = False
+    aliases: list[str] = Field(default_factory=list, description=ALIASES)
 
 
 class Person(StrictModel):
