@@ -37,10 +37,17 @@ from bt_humanoid.perception.free_space import free_spot
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS, describes_an_object, ground
 from bt_humanoid.perception.world_model import TrackedObject
 
-ABILITIES = (
-    "go to a place, pick things up, put them on the table, the counter or the shelf, bring them to you, "
-    "find them, walk forward or back, turn, wave, say something, and stop"
-)
+
+def abilities(context: PlanningContext) -> str:
+    """What the robot can be asked to do, in this world's words: said when a command is not understood."""
+    named = [f"the {_spoken(s)}" for s in context.world.surfaces] or ["a surface"]
+    surfaces = named[0] if len(named) == 1 else ", ".join(named[:-1]) + " or " + named[-1]
+    return (
+        f"go to a place, pick things up, put them on {surfaces}, bring them to you, "
+        "find them, walk forward or back, turn, wave, say something, and stop"
+    )
+
+
 DEFAULT_TURN = 90.0  # degrees for "turn left" without a number
 DEFAULT_STEP = 1.0  # m for "walk forward" without a number
 MAX_STEP = 5.0  # m: a longer relative move is a job for "go to"
@@ -182,7 +189,7 @@ class EmbeddedPlanner:
             handler = getattr(self, f"_{kind}")
             handler(match, state, context)
             return kind
-        raise PlanRefused(f"I can't {clause}. I can {ABILITIES}.")
+        raise PlanRefused(f"I can't {clause}. I can {abilities(context)}.")
 
     def _stop(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         pass

@@ -1,7 +1,9 @@
 """The one registry of leaf skills: name → parameter model, behaviour class, description.
 
-The mission schema, the docs, the README reference (and later the ASR grammar
-and the LLM prompt) are all generated from it.
+The mission schema, the docs, the reference and the LLM prompt's catalogue are
+generated from it. What a person can say or type is ``language/vocabulary.py``
+(one table of verbs for the planner's phrasings and the speech grammar); each
+kind of step there plans registered skills or behaviours, which a test checks.
 """
 
 from __future__ import annotations
