@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import queue
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,8 +26,9 @@ from bt_humanoid.language.questions import Questions
 from bt_humanoid.language.words import is_unclear
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import RecoverySettings
-from bt_humanoid.mission.spec import MissionSpec
+from bt_humanoid.mission.spec import MissionSpec, NodeSpec
 from bt_humanoid.perception.grounding import resolve
+from bt_humanoid.skills.params import named_objects
 
 MAX_QUESTIONS = 3  # answers taken per command; still unclear after them, the question stands and nothing runs
 
@@ -65,53 +66,41 @@ def make_planner(settings: LlmSettings | None) -> EmbeddedPlanner | LlmPlanner:
 
 
 def validate_planned_mission(mission: dict[str, Any], context: PlanningContext) -> dict[str, Any]:
-    """A planner's mission checked like a file and against the world; PlanRejected says what is wrong."""
+    """A planner's mission checked like a file and against what the robot believes; PlanRejected says what.
+
+    The loader runs every skill's own checks (names, the map, joint ranges), inside behaviours too, as for a
+    mission file; then each step is held to what only a planner is held to (``_belief_problems``).
+    """
     mission = {**mission, "world": context.world.name, "robot": context.robot}
     try:
-        MissionLoader.for_plans().load_data(mission, name="<plan>")
+        spec = MissionLoader.for_plans().load_data(mission, name="<plan>")
     except UserError as error:
         raise PlanRejected(str(error)) from None
-    for problem in _world_problems(mission["tree"], context):
+    for problem in _belief_problems(spec.tree, context):
         raise PlanRejected(problem)
     return mission
 
 
-def _world_problems(node: Any, context: PlanningContext, path: str = "tree"):
-    """Objects nobody has seen or named, and goals off the map, anywhere in a plan's tree."""
-    if isinstance(node, list):
-        for index, child in enumerate(node):
-            yield from _world_problems(child, context, f"{path}[{index}]")
-        return
-    if not isinstance(node, dict):
-        return
-    for key, value in node.items():
-        where = f"{path}.{key}"
-        named = key == "object" and isinstance(value, str) and not value.startswith("$")
-        if named and value not in context.world.objects:
+def _belief_problems(node: NodeSpec, context: PlanningContext, step: str | None = None) -> Iterator[str]:
+    """What a plan asks that the skills' own checks allow but a planner must not: an object the robot has
+    neither seen nor been told of (a description fits no object it knows: the model made it up), and a relative
+    move longer than a planned step. Each names the plan step it is in."""
+    step = node.where if node.where.startswith("<") else step  # the deepest node the plan itself wrote
+    if node.category == "skill" and node.settings is not None:
+        where = step or node.where
+        for parameter, value in named_objects(node.settings, node.raw):
+            if value in context.world.objects:
+                continue
             try:
                 resolve(value, context.belief, context.robot_pose)
             except KeyError as error:
                 names = ", ".join(context.world.objects)
-                yield f"{where}: unknown object {value!r} ({error.args[0]}); known objects: {names}"
-        goal = _goal_xy(key, value)
-        problem = context.world.outside_map(*goal) if goal is not None else None
-        if problem:
-            yield f"{where}: {problem}"
-        step = value.get("x") if key == "move_base" and isinstance(value, dict) and value.get("relative") else None
-        if isinstance(step, int | float) and abs(step) > MAX_STEP:
-            yield f"{where}.x: a relative move of {step} m; at most {MAX_STEP:.0f} m (use navigate)"
-        yield from _world_problems(value, context, where)
-
-
-def _goal_xy(key: str, value: Any) -> tuple[float, float] | None:
-    """The world x, y a node's parameter sends the robot to: a pose, or an absolute move_base."""
-    if key == "pose" and isinstance(value, list) and len(value) >= 2:
-        x, y = value[0], value[1]
-    elif key == "move_base" and isinstance(value, dict) and not value.get("relative"):
-        x, y = value.get("x"), value.get("y")
-    else:
-        return None
-    return (x, y) if isinstance(x, int | float) and isinstance(y, int | float) else None
+                yield f"{where}: {node.kind}.{parameter}: unknown object {value!r} ({error.args[0]}); known: {names}"
+        move = node.settings
+        if node.kind == "move_base" and getattr(move, "relative", False) and abs(getattr(move, "x", 0) or 0) > MAX_STEP:
+            yield f"{where}: a relative move of {move.x:g} m; at most {MAX_STEP:.0f} m (use navigate)"
+    for child in [*node.children, *([node.alternative] if node.alternative else [])]:
+        yield from _belief_problems(child, context, step)
 
 
 def plan_command(

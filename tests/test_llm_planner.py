@@ -24,6 +24,13 @@ UNKNOWN_SKILL = {"kind": "mission", "say": "Backflip!", "tree": {"backflip": {"h
 UNKNOWN_OBJECT = {"kind": "mission", "say": "Got it.", "tree": {"take": {"object": "golden key"}}}
 OFF_THE_MAP = {"kind": "mission", "say": "Going.", "tree": {"navigate": {"pose": [40.0, 3.0, 0.0]}}}
 WRONG_TYPE = {"kind": "mission", "say": "Turning.", "tree": {"move_base": {"relative": True, "yaw": "a lot"}}}
+# a description the skills accept (grounding could read it), of nothing the robot has seen or been told of
+UNSEEN = {
+    "kind": "mission",
+    "say": "Got it.",
+    "tree": {"sequence": [{"wave": {}}, {"take": {"object": "the purple cube"}}]},
+}
+LONG_STEP = {"kind": "mission", "say": "Walking.", "tree": {"move_base": {"relative": True, "x": 8.0}}}
 
 
 class ScriptedModel:
@@ -95,6 +102,8 @@ def test_a_good_plan_is_validated_and_used(model, context):
         (UNKNOWN_OBJECT, "unknown object 'golden key'"),
         (OFF_THE_MAP, "(40.0, 3.0) is outside the map"),
         (WRONG_TYPE, "yaw"),
+        (UNSEEN, "<plan> at tree.sequence[1].take: find.object: unknown object 'the purple cube'"),
+        (LONG_STEP, "<plan> at tree.move_base: a relative move of 8 m; at most 5 m"),
     ],
 )
 def test_a_bad_answer_goes_back_with_its_error_and_the_repair_is_used(model, context, bad, problem):

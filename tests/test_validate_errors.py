@@ -137,6 +137,21 @@ def test_a_mission_file_calls_subtree_files_of_its_own_and_a_plan_may_not(tmp_pa
     assert "m.yaml:2: subtree file '../wave.yaml' is outside" in str(refused.value)
 
 
+@pytest.mark.parametrize(
+    ("node", "problem"),
+    [
+        ("navigate_to: {pose: [40, 3, 0]}", "navigate_to: (40.0, 3.0) is outside the map"),
+        ("navigate: {pose: [40, 3, 0]}", "(40.0, 3.0) is outside the map"),
+        ("find: {object: golden key}", "find: unknown object 'golden key'"),
+    ],
+)
+def test_a_goal_off_the_map_or_an_object_nobody_could_ground_is_refused_in_a_file(tmp_path, capsys, node, problem):
+    # Before, only a planner's missions were checked for these (commanding._world_problems); a file ran them
+    path = write(tmp_path, "m.yaml", f"mission: far away\ntree:\n  {node}\n")
+    code, err = validate(capsys, path)
+    assert code == 2 and "m.yaml:3" in err and problem in err, err
+
+
 def test_recursive_subtree(tmp_path, capsys):
     write(
         tmp_path,

@@ -17,7 +17,7 @@ from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE
-from bt_humanoid.skills.params import check_name, check_object
+from bt_humanoid.skills.params import check_in_map, check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel, exactly_one
@@ -75,11 +75,12 @@ def lower_empty_torso(context: SkillContext) -> MotionHandle | None:
 
 
 def _places_and_objects(params: NavigateToParams | TurnParams, context: CheckContext) -> list[tuple[str, str]]:
-    """The named place, object and person of a base skill's parameters exist in the world."""
+    """The named place, object and person of a base skill's parameters exist in the world; a pose is on the map."""
     problems = check_name(params.place, context.world.places, "place", "place")
     problems += check_object(params.object, context.world)
     if isinstance(params, NavigateToParams):
         problems += check_name(params.person, context.world.person_names, "person", "person")
+        problems += check_in_map(params.pose[:2] if params.pose else None, context.world, "pose")
     return problems
 
 

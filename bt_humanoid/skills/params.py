@@ -5,9 +5,13 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
+from pydantic import BaseModel
+
 from bt_humanoid.errors import did_you_mean
 from bt_humanoid.perception.grounding import describes_an_object
 from bt_humanoid.sim.world_config import WorldConfig
+
+OBJECT_PARAMETER = "object"  # what every skill calls the parameter naming the object it acts on (check_object)
 
 
 def is_reference(value: Any) -> bool:
@@ -38,13 +42,21 @@ def check_name(value: str | None, valid: Iterable[str], parameter: str, what: st
     return [(parameter, f"unknown {what} '{value}' ({did_you_mean(value, valid)})")]
 
 
-def check_object(value: str | None, world: WorldConfig, parameter: str = "object") -> list[tuple[str, str]]:
+def check_object(value: str | None, world: WorldConfig, parameter: str = OBJECT_PARAMETER) -> list[tuple[str, str]]:
     """Compile-time check of an object parameter: a name the world gives, or a phrase to ground when it runs."""
     names = list(world.objects)
     if value is None or value in names or describes_an_object(value, [*names, *world.surfaces]):
         return []
     example = 'or a description such as "the red cube" or "the cup on the counter"'
     return [(parameter, f"unknown object '{value}' ({did_you_mean(value, names)}), {example}")]
+
+
+def named_objects(params: BaseModel, raw: dict[str, Any]) -> list[tuple[str, str]]:
+    """The (parameter, name or phrase) a skill's parameters give for its object, if any, and not by reference."""
+    value = getattr(params, OBJECT_PARAMETER, None)
+    if not isinstance(value, str) or is_reference(raw.get(OBJECT_PARAMETER)):
+        return []
+    return [(OBJECT_PARAMETER, value)]
 
 
 def check_in_map(at: tuple[float, float] | None, world: WorldConfig, parameter: str = "at") -> list[tuple[str, str]]:

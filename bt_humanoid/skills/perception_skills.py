@@ -19,8 +19,10 @@ from pydantic import Field
 
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.perception.grounding import resolve
+from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.manipulation_skills import _ManipulationSkill
 from bt_humanoid.skills.navigation_skills import at_a_surface, back_up, lower_empty_torso, tuck_empty_arms
+from bt_humanoid.skills.params import check_object
 from bt_humanoid.skills.phased import PhaseFailure
 from bt_humanoid.skills.registry import skill
 from bt_humanoid.strict_model import StrictModel
@@ -39,6 +41,10 @@ class FindParams(StrictModel):
 @skill("find", "locate an object: recall where it is believed to be, or look around for it, and look at it")
 class Find(_ManipulationSkill):
     Params = FindParams
+
+    @classmethod
+    def check(cls, params: FindParams, context: CheckContext) -> list[tuple[str, str]]:
+        return check_object(params.object, context.world)
 
     def phases(self):
         phases = [("recall", self._recall), *self._look_around("here")]
