@@ -16,6 +16,7 @@ from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.language.plan import mission_signature
 from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH
 from bt_humanoid.language.vocabulary import INTENTS, WorldVocabulary, planned_kinds
+from bt_humanoid.language.whisper_asr import world_prompt
 from bt_humanoid.mission.behaviors import BehaviorLibrary
 from bt_humanoid.paths import project_root
 from bt_humanoid.sim.world_config import load_world_config
@@ -81,7 +82,7 @@ def test_a_new_object_and_place_are_planned_when_typed(context, command, steps):
 def test_a_new_object_and_place_are_in_the_speech_grammar_and_heard(context):
     grammar = command_grammar(context.world)
     for words in ("tea tin", "tea caddy", "hallway", "entrance"):
-        assert words in grammar
+        assert words in grammar and words in world_prompt(context.world)  # Whisper is told them too
     recognizer = CommandRecognizer(context.world)
     for said in (
         "hey robot, pick up the tea tin",

@@ -21,6 +21,7 @@ import numpy as np
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.language.asr import Transcript
+from bt_humanoid.language.vocabulary import WorldVocabulary
 from bt_humanoid.sim.world_config import WorldConfig
 
 
@@ -31,9 +32,11 @@ def whisper_text(text: str) -> str:
 
 
 def world_prompt(world: WorldConfig) -> str:
-    """The words of this world, given to Whisper as earlier text so it spells them the planner's way."""
-    names = [*sorted(world.objects), *sorted(world.surfaces), *(p.replace("_", " ") for p in sorted(world.places))]
-    return "Hey robot, " + ", ".join(name.replace("_", " ") for name in names) + "."
+    """The words of this world (its names and aliases, as the grammar has them), given to Whisper as earlier text
+    so it spells them the planner's way."""
+    words = WorldVocabulary.of(world)
+    names = [*sorted(words.objects), *sorted(words.surfaces), *sorted(set(words.places) - set(words.surfaces))]
+    return "Hey robot, " + ", ".join(names) + "."
 
 
 class WhisperRecognizer:
