@@ -90,33 +90,42 @@ def run_main(argv: list[str] | None = None) -> int:
     console = Console(soft_wrap=True)
     if args.interactive or args.listen:
         return _interactive(args, console)
+    stack = None
     try:
-        from bt_humanoid.engine.runner import MissionRun
+        from bt_humanoid.engine.runner import MissionRun, stack_for
+        from bt_humanoid.engine.stack import RobotStack
         from bt_humanoid.mission.loader import MissionLoader
 
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
+        speech = _speech_out(args)
         if args.audio is not None:
             args.command = _heard_command(args, console)
         if args.command is not None:
-            outcome = _plan_from_command(args, console)
+            # one robot from its first look to its last step: the plan comes from what this stack believes
+            stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=speech)
+            outcome = _plan_from_command(args, console, stack)
             if outcome.spec is None:
+                stack.close()
                 return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
             spec = outcome.spec
         else:
             spec = MissionLoader().load_file(args.mission)
-        run = MissionRun(spec, seed=args.seed, tick_hz=args.tick_hz, speak=_speech_out(args))
+            stack = stack_for(spec, args.seed, speak=speech)
+        run = MissionRun(stack, spec, tick_hz=args.tick_hz)
         recorder = None
         if args.record:
             from bt_humanoid.viz.recorder import VideoRecorder
 
             recorder = VideoRecorder(run.sim, args.record)
-            run.executor.observers.append(recorder.capture)
+            stack.observers.append(recorder.capture)
     except UserError as error:
+        if stack is not None:
+            stack.close()
         return _fail_invalid(error)
 
     if args.realtime:
-        _pace_to_wall_clock(run)
+        _pace_to_wall_clock(stack)
 
     def on_interrupt(signum: int, frame: object) -> None:
         if run.stop_monitor.reason is not None:
@@ -139,6 +148,7 @@ def run_main(argv: list[str] | None = None) -> int:
             result = run.execute()
     finally:
         signal.signal(signal.SIGINT, previous)
+        stack.close()
         if recorder is not None:
             recorder.close()
 
@@ -151,16 +161,16 @@ def run_main(argv: list[str] | None = None) -> int:
     return EXIT_OK if result.success else EXIT_FAILED
 
 
-def _pace_to_wall_clock(run) -> None:  # a MissionRun (imported late: it loads MuJoCo)
+def _pace_to_wall_clock(stack) -> None:  # a RobotStack (imported late: it loads MuJoCo)
     """Hold each control step back until the wall clock catches up with simulation time."""
-    started = time.perf_counter() - run.sim.time
+    started = time.perf_counter() - stack.sim.time
 
     def pace() -> None:
-        ahead = run.sim.time - (time.perf_counter() - started)
+        ahead = stack.sim.time - (time.perf_counter() - started)
         if ahead > 0:
             time.sleep(ahead)
 
-    run.executor.observers.append(pace)
+    stack.observers.append(pace)
 
 
 def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
@@ -187,11 +197,12 @@ def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
 # --- commands: bt-plan, bt-run --command -----------------------------------------------
 
 
-def _plan_from_command(args: argparse.Namespace, console: Console):
-    """Plan ``--command``; print what the robot says and the mission; ask questions of ``--answer`` or the user."""
+def _plan_from_command(args: argparse.Namespace, console: Console, stack):  # stack: a RobotStack
+    """Plan ``--command`` from what ``stack`` sees at its first look; print what the robot says and the mission;
+    ask questions of ``--answer`` or the user."""
     import yaml
 
-    from bt_humanoid.commanding import context_at_start, plan_command
+    from bt_humanoid.commanding import plan_command
 
     if not args.command.strip():
         raise UserError("--command is empty", hint='say what to do, e.g. --command "pick up the red cube"')
@@ -207,8 +218,8 @@ def _plan_from_command(args: argparse.Namespace, console: Console):
         return reply
 
     planner = _planner(args)
-    context = context_at_start(args.world, args.robot)
-    outcome = plan_command(args.command, context, answer, planner)
+    stack.look()
+    outcome = plan_command(args.command, stack.planning_context(), answer, planner)
     plan = outcome.plan
     if plan.kind == "mission":
         console.print(f"[bold]robot:[/] {plan.say}", highlight=False)
@@ -251,10 +262,14 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
             if speech is not None:
                 speech(text)
 
-        session = InteractiveSession(args.world, args.robot, lines, say, _planner(args))
+        from bt_humanoid.engine.stack import RobotStack
+
+        planner = _planner(args)
+        stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=say)
+        session = InteractiveSession(stack, lines, say, planner)
         if args.listen:
             relay = _listener_thread(args, lines, session, console)
-            _pace_to_wall_clock(session.run)  # spoken words come in real time; so must the robot move
+            _pace_to_wall_clock(session.stack)  # spoken words come in real time; so must the robot move
     except UserError as error:
         return _fail_invalid(error)
     if args.listen:
@@ -268,7 +283,7 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
     try:
         session.serve()
     except KeyboardInterrupt:
-        session.run.request_stop("stop requested (Ctrl-C)")
+        session.request_stop("stop requested (Ctrl-C)")
     return EXIT_OK
 
 
@@ -288,7 +303,7 @@ def _listener_thread(args: argparse.Namespace, lines, session, console: Console)
     from bt_humanoid.language.sound_sources import file_blocks, microphone_blocks
 
     blocks = microphone_blocks() if args.listen == "microphone" else file_blocks(Path(args.listen))
-    world = session.run.context.world
+    world = session.stack.world
     listener = Listener(CommandRecognizer(world, dictation=True), transcriber=_transcriber(args, world))
 
     def show(label: str, words: str) -> None:
@@ -351,10 +366,17 @@ def plan_main(argv: list[str] | None = None) -> int:
     args = _plan_parser().parse_args(argv)
     args.command = args.text
     console = Console(soft_wrap=True)
+    stack = None
     try:
-        outcome = _plan_from_command(args, console)
+        from bt_humanoid.engine.stack import RobotStack
+
+        stack = RobotStack.load(args.world, args.robot)
+        outcome = _plan_from_command(args, console, stack)
     except UserError as error:
         return _fail_invalid(error)
+    finally:
+        if stack is not None:
+            stack.close()
     return EXIT_OK if outcome.plan.kind in ("mission", "stop") else EXIT_INVALID
 
 
@@ -366,6 +388,12 @@ def _validate_parser() -> argparse.ArgumentParser:
     parser.add_argument("files", nargs="*", type=Path, help="mission or behaviour YAML files")
     parser.add_argument(
         "--schema", nargs="?", const="-", metavar="PATH", help="write the mission JSON Schema (to stdout with no PATH)"
+    )
+    parser.add_argument(
+        "--expand",
+        action="store_true",
+        help="print each mission's tree as it will run: every safety guard and recovery step, with the values "
+        "it resolved and where each came from",
     )
     return parser
 
@@ -397,6 +425,19 @@ def validate_file(file: Path) -> str:
     return f"mission '{spec.header.mission}' ({count} nodes)"
 
 
+def _print_expanded(file: Path, console: Console) -> None:
+    """The mission in ``file`` as it will run (a behaviour has no robot or world to resolve against)."""
+    from bt_humanoid.engine.expand import expand
+    from bt_humanoid.mission.loader import MissionLoader
+    from bt_humanoid.yaml_source import read_yaml
+
+    source = read_yaml(file)
+    if isinstance(source.data, dict) and "behavior" in source.data:
+        console.print("  (a behaviour: --expand shows missions; call it from one to see it expanded)")
+        return
+    console.print(expand(MissionLoader().load_source(source)), markup=False)
+
+
 def _default_args(behavior) -> dict:
     """Arguments for checking a behaviour's tree on its own: its example, and a sample for any other required one."""
     samples = {str: "x", float: 0.0, int: 0, bool: False}
@@ -424,6 +465,8 @@ def validate_main(argv: list[str] | None = None) -> int:
             raise UserError("no files given", hint=f"e.g. bt-validate {missions_dir().name}/*.yaml")
         for file in args.files:
             console.print(f"[green]ok[/] {file}: {validate_file(file)}")
+            if args.expand:
+                _print_expanded(file, console)
     except UserError as error:
         return _fail_invalid(error)
     return EXIT_OK

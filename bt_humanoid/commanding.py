@@ -1,9 +1,8 @@
 """From a spoken or typed command to a mission: the robot looks, the planner plans, questions get answers.
 
-This sits beside the CLI, above the engine and the language package: the
-robot's view at the start comes from a short probe run (the world loaded,
-the head camera's first look fused into a WorldModel), and the planner reads
-that belief, never the simulator.
+This sits beside the CLI, above the engine and the language package. A command is planned from the belief of
+the robot stack that will carry it out (its map, and what its head camera has seen: one look when it starts),
+never from the simulator; the planned mission then runs on that same stack.
 """
 
 from __future__ import annotations
@@ -16,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.errors import UserError
 from bt_humanoid.language.asr import WAKE_WORD
 from bt_humanoid.language.embedded import MAX_STEP, EmbeddedPlanner, is_stop
@@ -37,21 +38,6 @@ MAX_QUESTIONS = 3  # answers taken per command; still unclear after them, the qu
 class CommandOutcome:
     plan: Plan  # the last answer of the planner
     spec: MissionSpec | None  # the validated mission, when there is one to run
-
-
-def context_at_start(world: str, robot: str) -> PlanningContext:
-    """What the robot knows when a command arrives: its map, and what one look from its start pose shows."""
-    from bt_humanoid.engine.runner import MissionRun
-
-    probe = {"mission": "look", "world": world, "robot": robot, "tree": {"wait": {"seconds": 0}}}
-    run = MissionRun(MissionLoader().load_data(probe, name="<look>"))
-    try:
-        if run.perceiver is not None:
-            run.perceiver.look()
-        return PlanningContext(run.context.world, run.context.world_model, run.robot.base.pose(), robot)
-    finally:
-        if run.perceiver is not None:
-            run.perceiver.close()
 
 
 def make_planner(settings: LlmSettings | None) -> EmbeddedPlanner | LlmPlanner:
@@ -155,28 +141,24 @@ class InteractiveSession:
 
     def __init__(
         self,
-        world: str,
-        robot: str,
+        stack: RobotStack,
         lines: queue.Queue[str | None],
         say: Callable[[str], None],
         planner: EmbeddedPlanner | LlmPlanner | None = None,
     ) -> None:
-        from bt_humanoid.engine.runner import MissionRun
-
+        self.stack = stack
         self.lines = lines
         self.say = say
         self.planner = planner or EmbeddedPlanner()
         self.pending: deque[str] = deque()
-        idle = {"mission": "ready", "world": world, "robot": robot, "tree": {"wait": {"seconds": 0}}}
-        self.run = MissionRun(MissionLoader().load_data(idle, name="<interactive>"), speak=say)
         self.questions = Questions(say)  # a recovery that asks whether to try again, while a mission runs
-        self.run.context.questions = self.questions
-        self.run.executor.observers.append(self._listen_while_busy)
+        stack.context.questions = self.questions
+        stack.observers.append(self._listen_while_busy)
+        self.mission: MissionRun | None = None  # the one running, or the last one
         self.results: list[Any] = []
         self.finished = False
         self.planner_asking = False  # the planner's question is out: the next line is its answer
-        if self.run.perceiver is not None:
-            self.run.perceiver.look()
+        stack.look()
 
     def serve(self) -> None:
         """Take commands until the person is done; every mission runs to its end and the robot to rest."""
@@ -185,14 +167,15 @@ class InteractiveSession:
                 if text.strip():
                     self._command(text)
         finally:
-            if self.run.perceiver is not None:
-                self.run.perceiver.close()
+            self.stack.close()
+
+    def request_stop(self, reason: str) -> None:
+        """Stop the mission that runs now, if one does."""
+        if self.mission is not None:
+            self.mission.request_stop(reason)
 
     def _command(self, text: str) -> None:
-        context = PlanningContext(
-            self.run.context.world, self.run.context.world_model, self.run.robot.base.pose(), self.run.spec.header.robot
-        )
-        outcome = plan_command(text, context, self._ask, self.planner)
+        outcome = plan_command(text, self.stack.planning_context(), self._ask, self.planner)
         plan = outcome.plan
         if plan.kind == "stop":
             self.say("I am not moving.")
@@ -201,8 +184,8 @@ class InteractiveSession:
             self.say(plan.say)
             return
         self.say(plan.say)
-        self.run.follow_with(ask_before_giving_up(outcome.spec))
-        result = self.run.execute(keep_open=True)
+        self.mission = MissionRun(self.stack, ask_before_giving_up(outcome.spec))
+        result = self.mission.execute()
         self.results.append(result)
         if result.safety and result.safety.startswith("stop"):
             return  # it said that it stopped
@@ -240,8 +223,8 @@ class InteractiveSession:
             if line is None:
                 self.finished = True
                 return
-            if self.run.stop_monitor.reason is None and is_stop(line):
-                self.run.request_stop("stop (typed)")
+            if self.mission is not None and self.mission.stop_monitor.reason is None and is_stop(line):
+                self.mission.request_stop("stop (typed)")
             elif self.questions.pending is not None:
                 self.questions.answer(line)
             else:

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, plan_main, run_main
-from bt_humanoid.commanding import InteractiveSession, context_at_start, plan_command
+from bt_humanoid.commanding import InteractiveSession, plan_command
 from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.testing.told import told_planning_context
 
@@ -34,8 +35,15 @@ def test_bt_plan_asks_and_takes_the_answer_from_the_command_line(capsys):
     assert "you: the bottle" in out and "object: water bottle" in out
 
 
+def _looked() -> RobotStack:
+    """The apartment's robot after one look from its start pose: what a command is planned from."""
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    stack.look()
+    return stack
+
+
 def test_the_planner_sees_with_the_camera_and_knows_unseen_things_by_name():
-    context = context_at_start("apartment", "wheeled_humanoid")
+    context = _looked().planning_context()
     seen = {o.name for o in context.belief.objects.values()}
     assert seen and seen <= {"blue cube", "red cube", "blue bottle", "white mug", "yellow ball"}
     assert "coffee mug" not in seen  # in the kitchen, out of sight from the start
@@ -44,16 +52,32 @@ def test_the_planner_sees_with_the_camera_and_knows_unseen_things_by_name():
 
 
 def test_a_typed_command_puts_the_red_cube_on_the_counter():
-    context = context_at_start("apartment", "wheeled_humanoid")
-    outcome = plan_command("put the red cube on the counter", context, lambda question: None)
+    stack = _looked()
+    outcome = plan_command("put the red cube on the counter", stack.planning_context(), lambda question: None)
     assert outcome.spec is not None, outcome.plan.say
-    run = MissionRun(outcome.spec)
+    run = MissionRun(stack, outcome.spec)
     result = run.execute()
     assert result.tree_status == "SUCCESS", result.summary()
     place = outcome.plan.mission["tree"]["fetch"]
     x, y, _ = run.truth.object_position("red cube")
     assert run.truth.rests_on("red cube", "counter") and np.hypot(x - place["x"], y - place["y"]) < 0.03
-    assert run.robot.max_speed() < 0.01
+    assert result.speed_at_end < 0.01
+
+
+def test_bt_run_with_a_command_builds_one_simulation_from_first_look_to_last_step(monkeypatch, capsys):
+    from bt_humanoid.sim import simulation
+
+    built: list[object] = []
+    original = simulation.Simulation.__init__
+
+    def counting(self, *args, **kwargs) -> None:
+        built.append(self)
+        original(self, *args, **kwargs)
+
+    monkeypatch.setattr(simulation.Simulation, "__init__", counting)
+    assert run_main(["--command", "turn left", "--no-live"]) == EXIT_OK
+    assert len(built) == 1
+    assert "I will turn left" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("argv", [["--command", "fly to the moon", "--no-live"], ["--command", "  ", "--no-live"]])
@@ -70,9 +94,10 @@ def test_bt_run_needs_a_mission_or_a_command(capsys):
 
 
 def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
-    context = context_at_start("apartment", "wheeled_humanoid")
+    stack = _looked()
+    context = stack.planning_context()
     outcome = plan_command("walk forward three meters", context, lambda question: None)
-    run = MissionRun(outcome.spec)
+    run = MissionRun(stack, outcome.spec)
     planner = EmbeddedPlanner()
     stopped: list[float] = []
 
@@ -82,7 +107,7 @@ def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
             run.request_stop("stop (typed)")
             stopped.append(run.sim.time)
 
-    run.executor.observers.append(type_stop_after_a_second)
+    stack.observers.append(type_stop_after_a_second)
     result = run.execute()
     assert stopped and result.tree_status == "FAILURE" and result.safety == "stop: stop (typed)"
     assert run.robot.max_speed() < 0.01 and result.said[-1] == "I have stopped."
@@ -94,27 +119,28 @@ def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
 def test_an_interactive_session_takes_commands_answers_and_a_stop_on_one_simulation():
     lines: queue.Queue = queue.Queue()
     said: list[str] = []
-    session = InteractiveSession("apartment", "wheeled_humanoid", lines, said.append)
+    stack = RobotStack.load("apartment", "wheeled_humanoid", speak=said.append)
+    session = InteractiveSession(stack, lines, said.append)
     drive_started: list[float] = []
 
     def type_stop_two_seconds_into_the_drive() -> None:  # typed while the robot works
         if said and said[-1] == "I will go to the kitchen." and not drive_started:
-            drive_started.append(session.run.sim.time)
-        if len(drive_started) == 1 and session.run.sim.time > drive_started[0] + 2.0:
+            drive_started.append(stack.sim.time)
+        if len(drive_started) == 1 and stack.sim.time > drive_started[0] + 2.0:
             lines.put("stop")
-            drive_started.append(session.run.sim.time)
+            drive_started.append(stack.sim.time)
 
-    session.run.executor.observers.append(type_stop_two_seconds_into_the_drive)
+    stack.observers.append(type_stop_two_seconds_into_the_drive)
     for line in ["grab the blue thing", "the bottle", "go to the kitchen", "do a backflip", None]:
         lines.put(line)
     session.serve()
     assert said[0].startswith("I see a") and "blue cube" in said[0] and "water bottle" in said[0]
     assert said[1] == "I will pick up the water bottle." and "Done." in said
-    assert session.run.truth.in_hand("water bottle") == "right"  # still holding it: one simulation throughout
+    assert stack.truth.in_hand("water bottle") == "right"  # still holding it: one simulation throughout
     assert "I will go to the kitchen." in said and "I have stopped." in said
     assert session.results[-1].safety == "stop: stop (typed)"
     assert said[-1].startswith("I can't do a backflip.")
-    assert session.run.robot.max_speed() < 0.01
+    assert stack.robot.max_speed() < 0.01
 
 
 def test_a_transcript_with_unclear_speech_is_refused_but_a_typed_ellipsis_is_not():

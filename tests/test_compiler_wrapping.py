@@ -1,10 +1,10 @@
-"""Every node the compiler emits sits under a Safety guard and a Recovery policy."""
+"""Every node the compiler emits sits under a Safety guard, with only its recovery steps between the two."""
 
 import pytest
 from py_trees.behaviour import Behaviour
 
 from bt_humanoid.cli import _default_args
-from bt_humanoid.engine.decorators import RecoveryPolicy, SafetyGuard
+from bt_humanoid.engine.decorators import RECOVERY_STEPS, OrElse, SafetyGuard
 from bt_humanoid.mission.behaviors import BehaviorLibrary
 from bt_humanoid.paths import project_root
 from bt_humanoid.testing.scenario import build_run
@@ -20,14 +20,14 @@ def assert_fully_wrapped(root: Behaviour) -> int:
     assert isinstance(root, SafetyGuard), "the root must be a Safety guard"
     checked = 0
     for node in root.iterate():
-        if isinstance(node, SafetyGuard):
-            assert isinstance(node.decorated, RecoveryPolicy), f"{node.decorated.name}: guard without recovery"
+        if isinstance(node, (SafetyGuard, *RECOVERY_STEPS)):
             continue
-        if isinstance(node, RecoveryPolicy):
-            assert isinstance(node.parent, SafetyGuard), f"{node.decorated.name}: recovery without guard"
-            continue
-        assert isinstance(node.parent, RecoveryPolicy), f"{node.name} is not wrapped"
-        assert isinstance(node.parent.parent, SafetyGuard), f"{node.name} has no Safety guard"
+        child, above = node, node.parent
+        while isinstance(above, RECOVERY_STEPS):
+            alternative = isinstance(above, OrElse) and above.children[1] is child
+            assert not alternative, f"{node.name}: an alternative without a Safety guard of its own"
+            child, above = above, above.parent
+        assert isinstance(above, SafetyGuard), f"{node.name} is not wrapped"
         checked += 1
     return checked
 
@@ -35,7 +35,8 @@ def assert_fully_wrapped(root: Behaviour) -> int:
 @pytest.mark.parametrize("mission", MISSIONS, ids=lambda p: p.name)
 def test_every_mission_is_fully_wrapped(mission):
     run = build_run(mission)
-    assert assert_fully_wrapped(run.compiled.root) == len(run.compiled.nodes) > 0
+    described = [path for _, path in run.compiled.nodes if not path.endswith(".or_else")]  # "or else" is a step
+    assert assert_fully_wrapped(run.compiled.root) == len(described) > 0
 
 
 @pytest.mark.parametrize("behavior", BEHAVIORS)
@@ -48,10 +49,10 @@ def test_every_behaviour_is_fully_wrapped(behavior):
 
 def test_the_check_catches_an_unwrapped_node():
     run = build_run({"mission": "x", "tree": {"sequence": [{"wait": {"seconds": 1}}]}})
-    sequence = run.compiled.root.decorated.decorated
+    sequence = run.compiled.root.decorated
     guard = sequence.children[0]
     # splice the bare leaf in place of its wrappers: the walk must notice
-    leaf = guard.decorated.decorated
+    leaf = guard.decorated.decorated  # safety → faults → wait
     leaf.parent = sequence
     sequence.children[0] = leaf
     with pytest.raises(AssertionError, match="not wrapped"):

@@ -119,7 +119,7 @@ def test_bt_eval_exits_2_with_one_line_for_bad_input(tmp_path, capsys):
 
 
 def test_summary_counts_what_the_episodes_report():
-    def episode(i: int, success: bool, fault: str | None, contacts: int = 0) -> dict:
+    def episode(i: int, success: bool, fault: str | None, contacts: int = 0, moving: bool = False) -> dict:
         return {
             "episode": i,
             "task": "bring me the {object}",
@@ -132,7 +132,8 @@ def test_summary_counts_what_the_episodes_report():
             "wall_s": 10.0,
             "person_contacts": contacts,
             "collision": not success,
-            "ended_moving": False,
+            "ended_moving": moving,
+            "moving_after_brake": False,
             "plan_ms": [30.0],
             "stop_latency_s": 0.4 if fault == "new_command" else None,
             "look_ms_median": 25.0,
@@ -140,12 +141,17 @@ def test_summary_counts_what_the_episodes_report():
             "qp_ms_p95": 0.6,
         }
 
-    episodes = [episode(0, True, None), episode(1, False, "push", contacts=3), episode(2, True, "new_command")]
+    episodes = [
+        episode(0, True, None),
+        episode(1, False, "push", contacts=3),
+        episode(2, True, "new_command", moving=True),
+    ]
     figures = summarize(episodes, wall_s=20.0, workers=2)
     assert figures["success"]["successes"] == 2 and figures["success"]["episodes"] == 3
     assert figures["by_fault"]["push"]["rate"] == 0.0
     assert figures["episodes_with_person_contact"] == 1
     assert figures["episodes_with_collision_stop"] == 1
+    assert figures["episodes_ended_moving"] == 1 and figures["episodes_moving_after_brake"] == 0
     assert figures["stop_latency_s"]["count"] == 1
     assert figures["real_time_factor_per_core"] == pytest.approx(6.0)
     assert [f["episode"] for f in figures["failures"]] == [1]

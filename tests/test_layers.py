@@ -1,5 +1,5 @@
 """Imports run one way: commanding and the CLI → engine → mission → skills → control, navigation, perception,
-language → sim (DESIGN.md, "Layout"). A module may import its own package and packages of lower layers only."""
+language → sim (docs/architecture.md, "Layers"). A module may import its own package and lower layers only."""
 
 import ast
 from pathlib import Path

@@ -3,10 +3,12 @@
 import pytest
 
 from bt_humanoid.engine.compiler import resolve_recovery
-from bt_humanoid.engine.decorators import RecoverySteps
+from bt_humanoid.engine.decorators import Ask, FaultWatch, RecoverySteps, Replan, Retry, SafetyGuard
+from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.language.questions import Answer, Questions, read_answer
 from bt_humanoid.paths import project_root
-from bt_humanoid.testing.scenario import Scenario, build_run, run_scenario
+from bt_humanoid.testing.scenario import Scenario, build_run, load_mission, run_scenario
 
 NEVER = {"check": {"key": "never", "op": "exists"}}  # a leaf that fails every time
 READY = {"check": {"key": "ready", "op": "exists"}}
@@ -21,9 +23,16 @@ def events(scenario, kind):
 
 
 def test_fields_come_from_the_most_specific_layer_that_sets_them():
-    node, mission, skill, robot = {"retries": 3}, {"retries": 1, "backoff": 2.0}, {"replan": 1}, {"backoff": 0.5}
-    assert resolve_recovery(node, mission, skill, robot) == RecoverySteps(retries=3, backoff=2.0, replan=1)
-    assert resolve_recovery({}, {"retries": None}, robot) == RecoverySteps(retries=0, backoff=0.5)
+    node, mission, skill = (
+        ("node", {"retries": 3}),
+        ("mission", {"retries": 1, "backoff": 2.0}),
+        ("skill", {"replan": 1}),
+    )
+    robot = ("robot", {"backoff": 0.5})
+    resolved = resolve_recovery(node, mission, skill, robot)
+    assert resolved.steps == RecoverySteps(retries=3, backoff=2.0, replan=1)
+    assert resolved.sources == {"retries": "node", "backoff": "mission", "replan": "skill", "ask": "built-in default"}
+    assert resolve_recovery(("node", {}), ("mission", {"retries": None}), robot).steps == RecoverySteps(backoff=0.5)
 
 
 def test_replan_starts_the_enclosing_sequence_over():
@@ -71,13 +80,16 @@ def test_the_node_setting_wins_and_conditions_ignore_mission_wide_settings():
 
 
 def test_grasp_defaults_to_one_retry_then_one_replan():
-    run_ = build_run({"mission": "t", "tree": {"sequence": [{"grasp": {"object": "red cube"}}]}})
-    grasp_policy = next(n.parent for n, path in run_.compiled.nodes if path.endswith("grasp"))
-    assert grasp_policy.steps.retries == 1 and grasp_policy.steps.replan == 1
-    assert grasp_policy.replan_target is run_.compiled.root.decorated
-    no_retries = build_run({"mission": "t", "recovery": {"retries": 0}, "tree": {"grasp": {"object": "red cube"}}})
-    policy = next(n.parent for n, path in no_retries.compiled.nodes if path.endswith("grasp"))
-    assert policy.steps.retries == 0 and policy.replan_target is None, "mission-wide beats the skill's default"
+    compiled = build_run({"mission": "t", "tree": {"sequence": [{"grasp": {"object": "red cube"}}]}}).compiled
+    assert compiled.recovery["sequence[0].grasp"].steps == RecoverySteps(retries=1, replan=1)
+    grasp = next(node for node, path in compiled.nodes if path.endswith("grasp"))
+    assert [type(step) for step in _steps_above(grasp)] == [FaultWatch, Retry, SafetyGuard]
+    replan = compiled.root.decorated
+    assert isinstance(replan, Replan) and [b.node for b in replan.budgets.values()] == ["sequence[0].grasp"]
+    alone = {"mission": "t", "recovery": {"retries": 0}, "tree": {"grasp": {"object": "red cube"}}}
+    compiled = build_run(alone).compiled
+    assert compiled.recovery["grasp"].steps.retries == 0, "mission-wide beats the skill's default"
+    assert [type(step) for step in _steps_above(compiled.nodes[0][0])] == [FaultWatch, SafetyGuard], "no sequence"
 
 
 def test_an_alternative_runs_when_the_node_still_fails():
@@ -103,18 +115,18 @@ def test_a_failed_alternative_fails_the_node_with_its_reason():
 
 def ask_run(tree, answers):
     """Run with someone to ask, who gives ``answers`` in turn as each question comes."""
-    run_ = build_run({"mission": "t", "tree": tree})
+    stack = build_run({"mission": "t", "tree": tree}).stack
     said: list[str] = []
     questions = Questions(said.append)
-    run_.context.questions = questions
-    run_.follow_with(run_.spec)  # compile again, with the question channel
+    stack.context.questions = questions
+    run_ = MissionRun(stack, load_mission({"mission": "t", "tree": tree}))  # compiled with the question channel
     replies = list(answers)
 
     def answer() -> None:
         if questions.awaiting and replies:
             questions.answer(replies.pop(0))
 
-    run_.executor.observers.append(answer)
+    stack.observers.append(answer)
     return Scenario(run_, run_.execute()), said
 
 
@@ -135,11 +147,11 @@ def test_ask_is_skipped_when_no_one_can_answer():
 
 def test_a_stop_while_asking_withdraws_the_question():
     tree = {"sequence": [{**NEVER, "recovery": {"ask": True}}]}
-    run_ = build_run({"mission": "t", "tree": tree})
+    stack = build_run({"mission": "t", "tree": tree}).stack
     questions = Questions(lambda text: None)
-    run_.context.questions = questions
-    run_.follow_with(run_.spec)
-    run_.executor.observers.append(lambda: questions.pending and run_.request_stop("stop (typed)"))
+    stack.context.questions = questions
+    run_ = MissionRun(stack, load_mission({"mission": "t", "tree": tree}))
+    stack.observers.append(lambda: questions.pending and run_.request_stop("stop (typed)"))
     result = run_.execute()
     assert result.safety.startswith("stop") and questions.pending is None
 
@@ -156,14 +168,29 @@ def test_neither_yes_nor_no():
     assert read_answer("the blue one") is None
 
 
+def _steps_above(node):
+    """The decorators from ``node`` up to and including its Safety guard."""
+    steps = []
+    while not isinstance(node, SafetyGuard):
+        node = node.parent
+        steps.append(node)
+    return steps
+
+
 def test_the_recovery_example_compiles_as_written_and_runs(run_mission):
     mission = project_root() / "missions" / "recovery.yaml"
-    policies = {path: node.parent for node, path in build_run(mission).compiled.nodes}
-    grasp = policies["sequence[3].sequence[2].grasp"]
+    compiled = build_run(mission).compiled
+    nodes = dict((path, node) for node, path in compiled.nodes)
+    grasp = compiled.recovery["sequence[3].sequence[2].grasp"]
     assert (grasp.steps.retries, grasp.steps.replan, grasp.steps.ask) == (1, 1, True)
-    assert grasp.replan_target is policies["sequence[3].sequence"]
-    assert policies["sequence[1].move_base"].steps == RecoverySteps(retries=2, backoff=1.0)
-    assert "sequence[4].sequence[1].put.or_else" in policies, "the per-skill alternative of put"
+    assert grasp.sources["ask"] == "node recovery:" and grasp.sources["backoff"] == "robot.yaml recovery:"
+    # the sequence that starts over for the grasp wears the replan step; the grasp wears its retry and question
+    assert isinstance(nodes["sequence[3].sequence"].parent, Replan)
+    steps = _steps_above(nodes["sequence[3].sequence[2].grasp"])
+    assert [type(step) for step in steps] == [FaultWatch, Retry, Ask, SafetyGuard]
+    assert steps[2].replan.sequence == "sequence[3].sequence" and steps[2].replan.limit == 1
+    assert compiled.recovery["sequence[1].move_base"].steps == RecoverySteps(retries=2, backoff=1.0)
+    assert "sequence[4].sequence[1].put.or_else" in nodes, "the per-skill alternative of put"
     scenario = run_mission(mission)
     assert scenario.result.success, scenario.result.summary()
     assert scenario.truth.rests_on("red cube", "table")
@@ -176,7 +203,7 @@ def test_an_interactive_session_routes_typed_lines_to_the_robots_question():
 
     lines: queue.Queue = queue.Queue()
     said: list[str] = []
-    session = InteractiveSession("apartment", "wheeled_humanoid", lines, said.append)
+    session = InteractiveSession(RobotStack.load("apartment", "wheeled_humanoid"), lines, said.append)
     session.questions.ask("I could not grasp: it slipped. Shall I try again?")
     assert session.awaiting_answer
     lines.put("yes")
@@ -185,6 +212,30 @@ def test_an_interactive_session_routes_typed_lines_to_the_robots_question():
     lines.put("say hello")
     lines.put(None)
     session.serve()
-    root = session.run.compiled.root.decorated
-    assert root.steps.ask and root.what == "say hello", "a planned command asks at its root before giving up"
+    root = session.mission.compiled.root.decorated
+    assert isinstance(root, Ask) and root.what == "say hello", "a planned command asks at its root before giving up"
     assert "Done." in said
+
+
+def test_bt_validate_expand_prints_every_wrapper_with_its_resolved_values(capsys):
+    from bt_humanoid.cli import validate_main
+    from bt_humanoid.mission.loader import MissionLoader
+
+    mission = project_root() / "missions" / "pick_and_place.yaml"
+    assert validate_main(["--expand", str(mission)]) == 0
+    out = capsys.readouterr().out
+    compiled = build_run(mission).compiled
+    for node, path in compiled.nodes:
+        if path.endswith(".or_else"):
+            assert "or else: the alternative" in out
+            continue
+        line = next(line for line in out.splitlines() if f"[{path}]" in line)
+        steps, sources = compiled.recovery[path].steps, compiled.recovery[path].sources
+        assert f"retries {steps.retries} ({sources['retries']})" in line and f"replan {steps.replan} (" in line
+    guards = sum(1 for node in compiled.root.iterate() if isinstance(node, SafetyGuard))
+    assert out.count("safety guard\n") == guards
+    for step, shown in ((Retry, "retry ×"), (Replan, "replan: start this sequence over"), (FaultWatch, "fault watch\n")):
+        count = sum(1 for node in compiled.root.iterate() if isinstance(node, step))
+        assert count == 0 or out.count(shown) == count, shown
+    limits = MissionLoader().load_file(mission).header.safety
+    assert f"max_base_speed {limits.max_base_speed:g} m/s (from mission safety:)" in out

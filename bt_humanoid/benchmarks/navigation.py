@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.navigation.grid_astar import grid_route_length
 from bt_humanoid.testing.scenario import build_run
 
@@ -52,8 +53,9 @@ class Outcome:
 
 def random_starts(count: int, rng: np.random.Generator, world: str = "apartment") -> list[tuple[float, float, float]]:
     """Free poses (x, y, yaw_deg) spread over the apartment (away from any walker's loop)."""
-    probe = build_run({"mission": "probe", "world": world, "tree": {"wait": {"seconds": 0}}})
-    return [free_start(probe.navigator.grid, probe.context.world, rng) for _ in range(count)]
+    probe = RobotStack.load(world, "wheeled_humanoid")
+    probe.close()
+    return [free_start(probe.navigator.grid, probe.world, rng) for _ in range(count)]
 
 
 def free_start(grid, world, rng: np.random.Generator, clearance: float = START_CLEARANCE) -> tuple[float, float, float]:

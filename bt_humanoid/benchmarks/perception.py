@@ -23,14 +23,15 @@ import math
 import statistics
 import time
 from dataclasses import dataclass
+from functools import cache
 
 import mujoco
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.perception.detector import detect
 from bt_humanoid.perception.rgbd_camera import RgbdCamera
-from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 
 PALETTE = {
@@ -60,11 +61,19 @@ class Truth:
     in_image: bool
 
 
+@cache
+def _probe() -> RobotStack:
+    """The bare apartment: its surfaces and objects, for drawing scenes."""
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    stack.close()
+    return stack
+
+
 def build_scene(rng: np.random.Generator):
-    """A MissionRun set up as one random scene, and the colour each object on the table was painted."""
-    probe = build_run({"mission": "probe", "tree": {"wait": {"seconds": 0}}})
+    """A robot stack set up as one random scene, and the colour each object on the table was painted."""
+    probe = _probe()
     table = probe.context.world_model.surface(SURFACE)
-    names = list(probe.context.world.objects)
+    names = list(probe.world.objects)
     chosen = list(rng.choice(names, size=int(rng.integers(1, 5)), replace=False))
     (x0, y0), (x1, y1) = table.region
     side = int(rng.integers(3))  # west, south, east: the chair blocks the north
@@ -78,7 +87,7 @@ def build_scene(rng: np.random.Generator):
     else:
         start = np.array([x1 + distance, centre[1] + along])
     yaw = math.atan2(*(centre - start)[::-1]) + rng.uniform(-0.25, 0.25)
-    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(*start, math.degrees(yaw)))
+    run = RobotStack.load("apartment", "wheeled_humanoid", robot_start=(*start, math.degrees(yaw)))
     spots: list[np.ndarray] = []
     while len(spots) < len(chosen):
         spot = np.array([rng.uniform(x0 + 0.08, x1 - 0.08), rng.uniform(y0 + 0.08, y1 - 0.08)])
@@ -205,6 +214,7 @@ def main(argv: list[str] | None = None) -> int:
         detect_ms.append((t2 - t1) * 1000)
         objects = truths(run, camera, list(run.context.world.objects), colours)
         camera.close()
+        run.close()
         eye = frame.position
         counted = [t for t in objects if t.in_image and t.visible > VISIBLE and np.linalg.norm(t.centre - eye) < RANGE]
         eligible += len(counted)

@@ -22,9 +22,9 @@ import mujoco
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
-from bt_humanoid.commanding import context_at_start
 from bt_humanoid.control.base_driver import BRAKE_ACCEL
 from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.language.asr import CommandRecognizer
 from bt_humanoid.language.audio import RATE, spoken, with_noise
 from bt_humanoid.language.embedded import EmbeddedPlanner, is_stop
@@ -102,7 +102,8 @@ def stop_trial(
     """(latency s, speed when stopped, s from the end of the word to the stop request) for one run of ``command``
     stopped at a random moving moment (the last is 0 for a typed stop)."""
     plan = EmbeddedPlanner().plan(command, context)
-    run = MissionRun(MissionLoader().load_data(plan.mission))
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    run = MissionRun(stack, MissionLoader().load_data(plan.mission))
     stop_after = EARLIEST + float(rng.uniform(0.0, 3.0))
     state: dict[str, float] = {}
 
@@ -124,8 +125,9 @@ def stop_trial(
         elif "stopped" in state and "rest" not in state and run.robot.at_rest():
             state["rest"] = now
 
-    run.executor.observers.append(watch)
+    stack.observers.append(watch)
     run.execute()
+    stack.close()
     if spoken_stop is not None:
         spoken_stop.listener.close()  # the recogniser is shared by the trials
     if "stopped" not in state or "rest" not in state:
@@ -138,7 +140,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--spoken", action="store_true", help='say "stop" into the listener instead of typing it')
     args = parse_benchmark_args(parser, argv, "trials")
     rng = np.random.default_rng(args.seed)
-    context = context_at_start("apartment", "wheeled_humanoid")  # what bt-run --command plans with
+    looking = RobotStack.load("apartment", "wheeled_humanoid")
+    looking.look()
+    context = looking.planning_context()  # what bt-run --command plans with: one look from the start pose
+    looking.close()
     recognizer = CommandRecognizer(context.world) if args.spoken else None
     how = "spoken" if args.spoken else "typed"
     print(f"bt-humanoid stop benchmark: {args.trials} {how} stops in mid-motion, seed {args.seed} (one core)")

@@ -70,6 +70,12 @@ class BaseDriver:
         self.last_step = io.time
         self.planned_velocity = np.zeros(3)  # the plan's velocity at ``elapsed``, before the limiter's share
         self.held_since: float | None = None  # when the limiter stopped the plan
+        self.speed_cap = config.limits.max_speed  # m/s: the mission's cap (safety: max_base_speed), set per run
+
+    def capped(self, requested: float | None = None) -> float:
+        """The speed a motion may plan for: what it asks (None: as fast as allowed) under the mission's cap and
+        the base's limit. The one place the cap is applied: skills ask for speeds, the base decides."""
+        return min(requested if requested is not None else math.inf, self.speed_cap, self.config.limits.max_speed)
 
     def allowed_share(self, velocity: np.ndarray) -> float:
         """The share (0 to 1) of ``velocity`` (vx, vy, yaw rate; world frame) the base may run at now."""
@@ -103,7 +109,7 @@ class BaseDriver:
         if self.handle is not None:
             self.handle.fail("pre-empted by a newer goal")
         limits = self.config.limits
-        speed = min(max_speed or limits.max_speed, limits.max_speed)
+        speed = self.capped(max_speed)
         start = self.reference.copy()
         target = np.array([x, y, start[2] + wrap_angle(yaw - start[2]) if shortest_turn else yaw])
         distance = float(np.hypot(*(target[:2] - start[:2])))

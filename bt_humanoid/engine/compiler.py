@@ -1,16 +1,18 @@
-"""MissionSpec → py_trees tree, every composite and leaf wrapped as Safety(Recovery(node)).
+"""MissionSpec → py_trees tree, every composite and leaf under a Safety guard and its recovery steps.
 
-The compiler owns safety: whatever produced the spec (a person, a behaviour
-library, a planner), each node it emits sits under a SafetyGuard reading the
-one SafetySupervisor and a RecoveryPolicy configured from the node, the
-mission's ``recovery:`` section (per skill, then mission-wide) and the
-robot's defaults, in that order.
+The compiler owns safety: whatever produced the spec (a person, a behaviour library, a planner), each node it
+emits sits under a SafetyGuard reading the one SafetySupervisor, and between the two the recovery steps the
+node's settings ask for (engine/decorators.py: ask, or else, retry, replan on sequences, a fault watch on
+skills). Each setting is resolved once, here, from the first layer that sets it: the node's ``recovery:``, the
+mission's ``recovery.skills.<skill>``, the mission's ``recovery:``, the skill's own default, the robot's
+``recovery:`` in robot.yaml; ``CompiledMission.recovery`` keeps what was resolved and from where
+(``bt-validate --expand`` prints it).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import py_trees
@@ -18,14 +20,36 @@ from py_trees.behaviour import Behaviour
 from py_trees.common import ParallelPolicy
 
 from bt_humanoid.engine.composites import RoundRobin
-from bt_humanoid.engine.decorators import RecoveryPolicy, RecoverySteps, SafetyGuard, SimTimeout
+from bt_humanoid.engine.decorators import (
+    Ask,
+    FaultWatch,
+    OrElse,
+    RecoveryLog,
+    RecoverySteps,
+    Replan,
+    ReplanBudget,
+    Retry,
+    SafetyGuard,
+    SimTimeout,
+)
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
 from bt_humanoid.safety.monitors import SafetySupervisor
 from bt_humanoid.skills import REGISTRY
 from bt_humanoid.skills.context import SkillContext
 
 GUARD_NAME = "safety"
-RECOVERY_NAME = "recovery"
+DEFAULT = "built-in default"
+
+#: a layer of recovery settings: (where it is written, its fields)
+Layer = tuple[str, Mapping[str, Any]]
+
+
+@dataclass(frozen=True)
+class ResolvedRecovery:
+    """A node's recovery steps, and the layer each came from."""
+
+    steps: RecoverySteps
+    sources: dict[str, str]
 
 
 @dataclass
@@ -35,6 +59,8 @@ class CompiledMission:
     supervisor: SafetySupervisor
     #: (node, path) of every node the mission describes, wrappers excluded
     nodes: list[tuple[Behaviour, str]] = field(default_factory=list)
+    #: path → the recovery resolved for the node there
+    recovery: dict[str, ResolvedRecovery] = field(default_factory=dict)
 
 
 def _label(node: NodeSpec) -> str:
@@ -49,48 +75,46 @@ def _label(node: NodeSpec) -> str:
     return node.kind
 
 
-def resolve_recovery(*layers: Mapping[str, Any]) -> RecoverySteps:
+def resolve_recovery(*layers: Layer) -> ResolvedRecovery:
     """Each field from the first layer that sets it (layers: most specific first); unset fields keep defaults."""
-    found = {}
+    found: dict[str, Any] = {}
+    sources: dict[str, str] = {}
     for name in (f.name for f in fields(RecoverySteps)):
-        value = next((layer[name] for layer in layers if layer.get(name) is not None), None)
+        where, value = next(((w, layer[name]) for w, layer in layers if layer.get(name) is not None), (DEFAULT, None))
         if value is not None:
             found[name] = value
-    return RecoverySteps(**found)
+        sources[name] = where
+    return ResolvedRecovery(RecoverySteps(**found), sources)
 
 
 class Compiler:
-    def __init__(
-        self,
-        context: SkillContext,
-        supervisor: SafetySupervisor,
-        on_recovery: Callable[[RecoveryPolicy, str], None] | None = None,
-    ) -> None:
+    def __init__(self, context: SkillContext, supervisor: SafetySupervisor, log: RecoveryLog | None = None) -> None:
         self.context = context
         self.supervisor = supervisor
-        self.on_recovery = on_recovery
+        self.log = log
 
     def compile(self, spec: MissionSpec) -> CompiledMission:
         section = spec.header.recovery
-        self.robot_recovery = self.context.robot_config.recovery.model_dump()
-        self.mission_recovery = section.model_dump(exclude={"skills"})
+        self.robot_recovery = ("robot.yaml recovery:", self.context.robot_config.recovery.model_dump())
+        self.mission_recovery = ("mission recovery:", section.model_dump(exclude={"skills"}))
         self.skill_recovery = {name: s.model_dump(exclude={"alternative"}) for name, s in section.skills.items()}
         self.skill_alternatives = spec.skill_alternatives
-        self.nodes: list[tuple[Behaviour, str]] = []
-        self.awaiting_target: list[RecoveryPolicy] = []  # policies that may replan, waiting for their sequence
-        root = self._wrapped(spec.tree)
-        return CompiledMission(root, spec, self.supervisor, self.nodes)
+        self.compiled = CompiledMission(None, spec, self.supervisor)  # type: ignore[arg-type]
+        self.replanning: list[tuple[Behaviour, ReplanBudget]] = []  # nodes that may replan, awaiting their sequence
+        self.compiled.root = self._wrapped(spec.tree)
+        return self.compiled
 
-    def _recovery_for(self, node: NodeSpec) -> RecoverySteps:
-        own = node.recovery.model_dump(exclude={"alternative"}) if node.recovery is not None else {}
+    def _recovery_for(self, node: NodeSpec) -> ResolvedRecovery:
+        own = ("node recovery:", node.recovery.model_dump(exclude={"alternative"}) if node.recovery else {})
         if node.category != "skill":  # a composite's failure was already recovered below
-            backoff = {"backoff": self.mission_recovery["backoff"]}
+            backoff = (self.mission_recovery[0], {"backoff": self.mission_recovery[1]["backoff"]})
             return resolve_recovery(own, backoff, self.robot_recovery)
         info = REGISTRY[node.kind]
-        per_skill = self.skill_recovery.get(node.kind, {})
+        per_skill = (f"mission recovery.skills.{node.kind}:", self.skill_recovery.get(node.kind, {}))
+        default = (f"{node.kind}'s default", info.recovery)
         if info.is_condition:  # a condition's answer is not a fault: mission-wide settings do not apply
-            return resolve_recovery(own, per_skill, info.recovery)
-        return resolve_recovery(own, per_skill, self.mission_recovery, info.recovery, self.robot_recovery)
+            return resolve_recovery(own, per_skill, default)
+        return resolve_recovery(own, per_skill, self.mission_recovery, default, self.robot_recovery)
 
     def _alternative_for(self, node: NodeSpec) -> NodeSpec | None:
         if node.alternative is not None:
@@ -99,44 +123,46 @@ class Compiler:
             return self.skill_alternatives.get(node.kind)
         return None
 
-    def _policy(self, child: Behaviour, steps: RecoverySteps, what: str) -> RecoveryPolicy:
-        context = self.context
-        return RecoveryPolicy(
-            RECOVERY_NAME, child, steps, context.clock, self.supervisor, context.questions, self.on_recovery, what
-        )
-
     def _wrapped(self, node: NodeSpec) -> Behaviour:
-        waiting = len(self.awaiting_target)
+        """``node`` compiled, under its recovery steps and its Safety guard (outermost)."""
+        below = len(self.replanning)
         inner = self._build(node)
         inner.bt_path = node.path  # type: ignore[attr-defined]
-        self.nodes.append((inner, node.path))
-        steps = self._recovery_for(node)
-        what = node.name or node.kind
-        alternative = self._alternative_for(node)
-        if alternative is None:
-            policy = self._policy(inner, steps, what)
-        else:
-            # retries stay with the node; its alternative runs when they are spent; replan and ask come after both
-            first = SafetyGuard(
-                GUARD_NAME,
-                self._policy(inner, replace(steps, replan=0, ask=False), what),
-                self.supervisor,
-                leaf=node.category == "skill",
-            )
-            either = py_trees.composites.Selector(
-                f"{what}, or else", memory=True, children=[first, self._wrapped(alternative)]
-            )
-            either.bt_path = f"{node.path}.or_else"  # type: ignore[attr-defined]
-            self.nodes.append((either, either.bt_path))  # type: ignore[attr-defined]
-            policy = self._policy(either, replace(steps, retries=0), what)
+        self.compiled.nodes.append((inner, node.path))
+        resolved = self._recovery_for(node)
+        self.compiled.recovery[node.path] = resolved
+        steps, what = resolved.steps, node.name or node.kind
+        clock, supervisor = self.context.clock, self.supervisor
+        wrapped = inner
+        if node.category == "skill":
+            wrapped = FaultWatch("faults", wrapped, supervisor)
         if isinstance(inner, py_trees.composites.Sequence) and node.category != "behavior":
-            # a sequence starts over for the nodes below it that replan (up to the next sequence down)
-            for below in self.awaiting_target[waiting:]:
-                below.replan_target = policy
-            del self.awaiting_target[waiting:]
-        if steps.replan:
-            self.awaiting_target.append(policy)
-        return SafetyGuard(GUARD_NAME, policy, self.supervisor, leaf=node.category == "skill" and alternative is None)
+            # this sequence starts over for the nodes below it that may replan (up to the next sequence down)
+            claimed, self.replanning[below:] = self.replanning[below:], []
+            if claimed:
+                wrapped = self._logged(Replan(wrapped, node.path, what, steps.backoff, clock, supervisor))
+                for top, budget in claimed:
+                    wrapped.watch(top, budget)
+        if steps.retries:
+            wrapped = self._logged(Retry(wrapped, node.path, steps.retries, steps.backoff, clock, supervisor))
+        alternative = self._alternative_for(node)
+        if alternative is not None:
+            wrapped = OrElse(what, wrapped, self._wrapped(alternative))
+            wrapped.bt_path = f"{node.path}.or_else"  # type: ignore[attr-defined]
+            self.compiled.nodes.append((wrapped, wrapped.bt_path))  # type: ignore[attr-defined]
+        budget = ReplanBudget(node.path, what, steps.replan) if steps.replan else None
+        if steps.ask:
+            questions = self.context.questions
+            wrapped = self._logged(Ask(wrapped, node.path, what, questions, budget, clock, supervisor))
+        guard = SafetyGuard(GUARD_NAME, wrapped, supervisor)
+        if budget is not None:
+            self.replanning.append((guard, budget))
+        return guard
+
+    def _logged(self, step):
+        if self.log is not None:
+            step.log = self.log
+        return step
 
     def _build(self, node: NodeSpec) -> Behaviour:
         label = _label(node)

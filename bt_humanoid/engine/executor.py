@@ -31,6 +31,7 @@ class Executor:
         events: EventLog,
         tick_hz: float = 20.0,
         control_hz: float = 100.0,
+        observers: list[Callable[[], None]] | None = None,
     ) -> None:
         self.compiled = compiled
         self.root = compiled.root
@@ -43,11 +44,13 @@ class Executor:
         robot.set_control_period(steps_per_control * sim.timestep)
         self.controls_per_tick = max(1, round(self.tick_period / (steps_per_control * sim.timestep)))
         self.tick_count = 0
-        self.observers: list[Callable[[], None]] = []  # called after every control period (recorder, pacing)
+        #: called after every control period (recorder, pacing): the stack's list, shared by its missions
+        self.observers: list[Callable[[], None]] = observers if observers is not None else []
         self.tick_listeners: list[Callable[[Executor], None]] = []  # called after every tick (live view)
         self._last_status: dict[int, Status] = {}
         self._running: list[Behaviour] = []
         self._violation_logged = False
+        self.speed_at_end = 0.0  # the robot's fastest axis when the tree finished, before it was braked to rest
 
     @property
     def running(self) -> list[Behaviour]:
@@ -117,8 +120,9 @@ class Executor:
                 status = Status.FAILURE
                 break
             self.advance()
+        self.speed_at_end = self.robot.max_speed()  # measured before halt() brakes and waits for rest
         self.halt()
-        self.events.add(self.sim.time, "end", status=status.name)
+        self.events.add(self.sim.time, "end", status=status.name, speed_at_finish=round(self.speed_at_end, 4))
         return status
 
     def halt(self) -> None:

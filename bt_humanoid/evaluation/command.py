@@ -140,7 +140,8 @@ def _print(console: Console, figures: dict[str, Any]) -> None:
         f"time to complete (successes): median {ms(done['median'], 's')}, p95 {ms(done['p95'], 's')}",
         f"episodes with a person touched: {figures['episodes_with_person_contact']}; "
         f"stopped by the bumper: {figures['episodes_with_collision_stop']}; "
-        f"ended still moving: {figures['episodes_ended_moving']}",
+        f"tree finished while moving: {figures['episodes_ended_moving']}; "
+        f"moving after braking: {figures['episodes_moving_after_brake']}",
         f"stop latency (new command → rest): median {ms(latency['median'], 's', 2)}, "
         f"p95 {ms(latency['p95'], 's', 2)} over {latency['count']}",
         f"plan {ms(figures['plan_ms_median'])}, camera look {ms(figures['look_ms_median'])}, "

@@ -22,17 +22,16 @@ import numpy as np
 from bt_humanoid.benchmarks.navigation import free_start
 from bt_humanoid.commanding import plan_command
 from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.engine.verdict import check_condition
 from bt_humanoid.evaluation import faults as fault_kinds
 from bt_humanoid.evaluation.scenes import nudge, reachable_spot
 from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite
-from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
-from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 
-AT_REST = 0.01  # m/s or rad/s: faster than this at the end counts as still moving
+AT_REST = 0.01  # m/s or rad/s: faster than this when the tree finishes counts as still moving
 
 
 @cache
@@ -41,18 +40,18 @@ def _suite(path: str) -> Suite:
 
 
 @cache
-def _probe(world: str, robot: str) -> MissionRun:
-    """A run of the bare world: its map and surfaces, for drawing scenes (one per worker)."""
-    run = build_run({"mission": "probe", "world": world, "robot": robot, "tree": {"wait": {"seconds": 0}}})
-    if run.perceiver is not None:
-        run.perceiver.close()
-    return run
+def _probe(world: str, robot: str) -> RobotStack:
+    """The bare world's stack: its map and surfaces, for drawing scenes (one per worker)."""
+    stack = RobotStack.load(world, robot)
+    stack.close()
+    return stack
 
 
 class Draw:
     """What one episode drew: task, names, start, spots, fault."""
 
     def __init__(self, suite: Suite, index: int) -> None:
+        self.index = index
         rng = np.random.default_rng([suite.seed, index])
         self.rng = rng
         weights = np.array([task.weight for task in suite.tasks])
@@ -95,25 +94,28 @@ def run_episode(
         "surface": draw.surface or None,
         "fault": fault.kind if fault else None,
     }
-    run = _set_up(suite, draw, record)
+    stack = _set_up(suite, draw, record)
     try:
-        record |= _play(suite, suite_file, task, draw, fault, run)
+        record |= _play(suite, suite_file, task, draw, fault, stack)
         if events is not None:
-            events.extend(run.events.events)
+            events.extend(stack.events.events)
     finally:
-        if run.perceiver is not None:
-            run.perceiver.close()
+        stack.close()
     record["wall_s"] = round(time.perf_counter() - started, 3)
     return record
 
 
-def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> MissionRun:
-    """The episode's run, its scene drawn: obstacles nudged, the object on a random spot, a random start."""
+def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> RobotStack:
+    """The episode's robot stack, its scene drawn: obstacles nudged, the object on a random spot, a random start.
+
+    The stack's seed (route planning) comes from the suite's seed and the episode's index, like everything else
+    the episode draws, without taking numbers from the draw's own generator.
+    """
     probe = _probe(suite.world, suite.robot)
-    rng, world = draw.rng, probe.context.world
+    rng, world = draw.rng, probe.world
     start = free_start(probe.navigator.grid, world, rng) if suite.randomize.start == "random" else None
-    idle = {"mission": "ready", "world": suite.world, "robot": suite.robot, "tree": {"wait": {"seconds": 0}}}
-    run = build_run(idle, robot_start=start)
+    seed = int(np.random.SeedSequence([suite.seed, draw.index]).generate_state(1)[0])
+    run = RobotStack.load(suite.world, suite.robot, seed, robot_start=start)
     model = run.sim.model
     for name in suite.randomize.obstacles:  # the furniture rearranged, and the robot's floor plan redrawn
         body = model.body(name).id
@@ -142,16 +144,15 @@ def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> MissionRun:
     return run
 
 
-def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, run: MissionRun) -> dict[str, Any]:
+def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: RobotStack) -> dict[str, Any]:
     """Plan (for commands), run with the fault armed, follow a new command if one arrives, and judge."""
     figures: dict[str, Any] = {"plan_ms": [], "stop_latency_s": None}
-    if run.perceiver is not None:
-        run.perceiver.look()
+    stack.look()
     expect = fill(task.expect, draw.slots)
-    spec = _mission(suite, suite_file, task, draw, run, figures)
+    spec = _mission(suite, suite_file, task, draw, stack, figures)
     if isinstance(spec, str):
-        return _verdict(run, None, expect, figures, failure=spec)
-    run.follow_with(spec)
+        return _verdict(stack, None, expect, figures, failure=spec)
+    run = MissionRun(stack, spec)
     injector = _arm(fault, run, draw) if fault is not None else None
     model = run.sim.model
     on_person = np.isin(model.geom_bodyid, sorted(run.truth.people_bodies()))  # per geom
@@ -164,35 +165,33 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, run: Mis
         if np.any((on_person[g1] & on_robot[g2]) | (on_person[g2] & on_robot[g1])):
             touched.append(run.sim.time)
 
-    run.executor.observers.append(watch_people)
-    result = run.execute(keep_open=True)
+    stack.observers.append(watch_people)
+    result = run.execute()
     if isinstance(injector, fault_kinds.NewCommand) and injector.fired is not None:
         rest = next((e["t"] for e in reversed(result.events.events) if e["event"] in ("rest", "moving")), None)
         figures["stop_latency_s"] = round(rest - injector.fired.time, 3) if rest is not None else None
         command = fill(injector.settings.command, draw.slots)
         expect = fill(injector.settings.expect, draw.slots)
-        follow = _planned(command, suite, run, figures)
+        follow = _planned(command, suite, stack, figures)
         if isinstance(follow, str):
-            return _verdict(run, result, expect, figures, failure=follow, injector=injector, touched=touched)
-        run.follow_with(follow)
-        result = run.execute(keep_open=True)
-    return _verdict(run, result, expect, figures, injector=injector, touched=touched)
+            return _verdict(stack, result, expect, figures, failure=follow, injector=injector, touched=touched)
+        result = MissionRun(stack, follow).execute()
+    return _verdict(stack, result, expect, figures, injector=injector, touched=touched)
 
 
-def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, run: MissionRun, figures: dict):
+def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, stack: RobotStack, figures: dict):
     """The episode's validated mission, or why there is none (a string)."""
     if task.mission is not None:
         spec = MissionLoader().load_file(Path(suite_file).parent / task.mission)
         spec.header.safety.time_budget = suite.time_budget
         return spec
-    return _planned(fill(task.command, draw.slots), suite, run, figures)
+    return _planned(fill(task.command, draw.slots), suite, stack, figures)
 
 
-def _planned(command: str, suite: Suite, run: MissionRun, figures: dict):
+def _planned(command: str, suite: Suite, stack: RobotStack, figures: dict):
     """Plan a command from what the robot believes now; the validated mission, or the planner's answer."""
-    context = PlanningContext(run.context.world, run.context.world_model, run.robot.base.pose(), suite.robot)
     started = time.perf_counter()
-    outcome = plan_command(command, context, lambda question: None)
+    outcome = plan_command(command, stack.planning_context(), lambda question: None)
     figures["plan_ms"].append(round((time.perf_counter() - started) * 1000, 2))
     if outcome.plan.kind != "mission" or outcome.plan.mission is None:
         return f"planner: {outcome.plan.say}"
@@ -218,7 +217,7 @@ def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:
 
 
 def _verdict(
-    run: MissionRun,
+    run: RobotStack,
     result,
     expect: list[dict[str, Any]],
     figures: dict[str, Any],
@@ -242,7 +241,10 @@ def _verdict(
             failure = "not done: " + "; ".join(unmet)
     qp = [t * 1000 for t in run.robot.whole_body.solve_times]
     looks = [t * 1000 for t in run.perceiver.look_times] if run.perceiver is not None else []
-    speed = run.robot.max_speed()
+    # measured when the tree finished, before the executor braked and waited for rest: a tree that reports done
+    # while the robot still moves is what this catches; a safety stop halts a moving robot by design
+    finish_speed = result.speed_at_end if result is not None else run.robot.max_speed()
+    speed = run.robot.max_speed()  # after braking to rest (up to the executor's BRAKE_TIMEOUT)
     return {
         "success": failure is None and not unmet,
         "failure": failure,
@@ -250,7 +252,9 @@ def _verdict(
         "sim_time": round(run.sim.time, 3),
         "person_contacts": len(touched or []),
         "collision": bool(result is not None and result.safety and result.safety.startswith("collision")),
-        "ended_moving": speed >= AT_REST,
+        "ended_moving": finish_speed >= AT_REST and not (result is not None and result.safety),
+        "speed_at_finish": round(finish_speed, 4),
+        "moving_after_brake": speed >= AT_REST,
         "final_speed": round(speed, 4),
         "plan_ms": figures["plan_ms"],
         "stop_latency_s": figures["stop_latency_s"],

@@ -64,6 +64,7 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
         "episodes_with_person_contact": sum(e["person_contacts"] > 0 for e in episodes),
         "episodes_with_collision_stop": sum(e["collision"] for e in episodes),
         "episodes_ended_moving": sum(e["ended_moving"] for e in episodes),
+        "episodes_moving_after_brake": sum(e["moving_after_brake"] for e in episodes),
         "stop_latency_s": {"median": _median(latencies), "p95": _p95(latencies), "count": len(latencies)},
         "plan_ms_median": _median([t for e in episodes for t in e["plan_ms"]]),
         "look_ms_median": _median([e["look_ms_median"] for e in episodes if e["look_ms_median"] is not None]),
@@ -110,7 +111,9 @@ def markdown(figures: dict[str, Any], command: str) -> str:
         f"| time to complete, successful episodes | median {number(done['median'])} s, p95 {number(done['p95'])} s |",
         f"| episodes in which the robot touched a person | {figures['episodes_with_person_contact']} |",
         f"| episodes stopped by the bumper | {figures['episodes_with_collision_stop']} |",
-        f"| episodes that ended with the robot still moving | {figures['episodes_ended_moving']} |",
+        "| episodes whose tree finished with the robot still moving (faster than 0.01 m/s or rad/s; "
+        f"safety stops not counted) | {figures['episodes_ended_moving']} |",
+        f"| episodes with the robot still moving 5 s after braking | {figures['episodes_moving_after_brake']} |",
         f"| stop latency, new command → at rest | median {number(latency['median'], 2)} s, "
         f"p95 {number(latency['p95'], 2)} s ({latency['count']} episodes) |",
         f"| planning, text → validated mission | median {number(figures['plan_ms_median'])} ms |",

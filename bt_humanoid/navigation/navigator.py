@@ -83,12 +83,13 @@ class Navigator:
 
     # ------------------------------------------------------------------ goals
 
-    def go_to(self, goal: np.ndarray, max_speed: float) -> MotionHandle:
-        """Plan to ``goal`` (x, y, yaw) and follow the route; the handle fails with the reason if there is none."""
+    def go_to(self, goal: np.ndarray, max_speed: float | None = None) -> MotionHandle:
+        """Plan to ``goal`` (x, y, yaw) and follow the route at up to ``max_speed`` (None: as fast as the mission's
+        cap allows); the handle fails with the reason if there is none."""
         self._finish_goal("pre-empted by a new goal")
         if self.follower.dt != self.robot.control_period:  # the executor chose the control rate after we were built
             self.follower = RouteFollower(self.robot.base, self.robot.config.base, self.robot.control_period)
-        self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), max_speed, 0
+        self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), self.robot.base.capped(max_speed), 0
         self.waiting_since = None
         handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
         self.handle = handle
@@ -152,7 +153,7 @@ class Navigator:
 
     def _plan(self) -> Route:
         try:
-            route = plan_route(self.grid, self.robot.base.pose(), self.goal, self.clearance)
+            route = plan_route(self.grid, self.robot.base.pose(), self.goal, self.clearance, seed=self.sim.seed)
         except PlanError:
             self.planning_times.append(0.0)
             raise
@@ -178,7 +179,9 @@ class Navigator:
         if not np.any(self.grid.observed):
             return False
         try:
-            plan_route(self.grid.without_observed(), self.robot.base.pose(), self.goal, self.clearance)
+            plan_route(
+                self.grid.without_observed(), self.robot.base.pose(), self.goal, self.clearance, seed=self.sim.seed
+            )
         except PlanError:
             return False
         return True

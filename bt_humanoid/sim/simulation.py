@@ -61,6 +61,7 @@ class Simulation:
         for joint in self.robot.actuated_joints:
             actuator = self.actuator_for_joint(joint)
             self.data.ctrl[actuator] = self.data.qpos[self.model.joint(joint).qposadr[0]]
+        self.seed = seed  # the run's seed: whatever draws random numbers (route planning) starts from it
         self.rng = np.random.default_rng(seed)
         mujoco.mj_forward(self.model, self.data)
 

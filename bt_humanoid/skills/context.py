@@ -50,7 +50,6 @@ class SkillContext(CheckContext):
 
     robot: RobotController = None  # type: ignore[assignment]
     clock: Callable[[], float] = lambda: 0.0
-    max_base_speed: float = 0.8  # m/s: the mission's safety cap
     blackboard: Blackboard = field(default_factory=Blackboard)
     speak: Callable[[str], None] = print
     world_model: WorldModel = field(default_factory=WorldModel)  # what the robot believes; skills read only this

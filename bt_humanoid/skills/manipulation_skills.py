@@ -164,10 +164,9 @@ class StandNear(_ManipulationSkill):
             )
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
-        speed = min(p.max_speed, self.context.max_base_speed)
         if self._straight_way_blocked(np.array([x, y])):  # the object moved, or we stand on another side
-            return self.context.navigator.go_to(np.array([x, y, yaw]), speed)
-        return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
+            return self.context.navigator.go_to(np.array([x, y, yaw]), p.max_speed)
+        return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed)
 
     def _straight_way_blocked(self, stance: np.ndarray) -> bool:
         """Would the footprint, driven straight to ``stance``, cross furniture on the map before it arrives?"""

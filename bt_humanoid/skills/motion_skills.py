@@ -69,8 +69,7 @@ class MoveBase(Skill):
         outside = self.context.world.outside_map(round(x, 2), round(y, 2))
         if outside is not None:  # a relative move from here would leave the map: refuse before moving
             raise ValueError(f"the goal {outside}")
-        speed = min(s for s in (p.max_speed, self.context.max_base_speed) if s is not None)
-        return self.context.robot.base.move_to(x, y, yaw, max_speed=speed)
+        return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed)
 
 
 class MoveJointsParams(StrictModel):

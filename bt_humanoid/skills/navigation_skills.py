@@ -35,9 +35,6 @@ class _BaseSkill(PhasedSkill):
             raise PhaseFailure("this robot has no navigation stack")
         return self.context.navigator
 
-    def _speed(self, requested: float | None) -> float:
-        return min(s for s in (requested, self.context.max_base_speed) if s is not None)
-
     def _look_ahead(self) -> MotionHandle | None:
         posture = self.context.robot_config.postures.get(LOOK_AHEAD_POSTURE)
         return self.context.robot.joints.move(dict(posture)) if posture else None
@@ -119,7 +116,7 @@ class NavigateTo(_BaseSkill):
     def _navigate(self) -> MotionHandle:
         navigator = self._navigator()
         goal, what = self._goal()
-        handle = navigator.go_to(goal, self._speed(self.params.max_speed))
+        handle = navigator.go_to(goal, self.params.max_speed)
         if handle.done and handle.result:
             raise PhaseFailure(f"{what}: {handle.result}")
         self.what = what

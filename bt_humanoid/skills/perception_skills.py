@@ -84,7 +84,7 @@ class Find(_ManipulationSkill):
             return None
         x, y, yaw = place.pose
         goal = np.array([x, y, math.radians(yaw)])
-        handle = self.context.navigator.go_to(goal, min(SEARCH_SPEED, self.context.max_base_speed))
+        handle = self.context.navigator.go_to(goal, SEARCH_SPEED)
         return None if handle.done else handle  # a place it cannot reach is skipped
 
     def _recall(self) -> None:

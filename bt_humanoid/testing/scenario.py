@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from bt_humanoid.engine.runner import MissionRun, RunResult
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.sim.ground_truth import GroundTruth
 
 
@@ -35,29 +37,36 @@ class Scenario:
         return [e.get("feedback", "") for e in self.events if e["event"] == "status" and e["node"] == node]
 
     def final_speed(self) -> float:
-        return self.run.robot.max_speed()
+        """The robot's fastest axis when the tree finished, before the executor braked it and waited for rest."""
+        return self.result.speed_at_end
+
+
+def load_mission(mission: str | Path | dict) -> MissionSpec:
+    """A validated mission from a file path, YAML text or a mission mapping."""
+    loader = MissionLoader()
+    if isinstance(mission, dict):
+        return loader.load_data(mission)
+    if isinstance(mission, Path) or (isinstance(mission, str) and mission.endswith(".yaml") and "\n" not in mission):
+        return loader.load_file(Path(mission))
+    return loader.load_text(mission)
 
 
 def build_run(
     mission: str | Path | dict, seed: int | None = None, robot_start: tuple[float, float, float] | None = None
 ) -> MissionRun:
-    """A MissionRun from a file path, YAML text or a mission mapping (not yet executed).
+    """A MissionRun on a fresh RobotStack from a file path, YAML text or a mission mapping (not yet executed).
 
     ``robot_start`` [x, y, yaw_deg] replaces the world's start pose (test and benchmark set-up).
     """
-    loader = MissionLoader()
-    if isinstance(mission, dict):
-        spec = loader.load_data(mission)
-    elif isinstance(mission, Path) or (isinstance(mission, str) and mission.endswith(".yaml") and "\n" not in mission):
-        spec = loader.load_file(Path(mission))
-    else:
-        spec = loader.load_text(mission)
-    if robot_start is not None:
-        world = spec.known.world.model_copy(update={"robot_start": tuple(robot_start)})
-        spec.known = replace(spec.known, world=world)
-    return MissionRun(spec, seed=seed)
+    spec = load_mission(mission)
+    header = spec.header
+    stack = RobotStack.load(header.world, header.robot, header.seed if seed is None else seed, robot_start)
+    return MissionRun(stack, spec)
 
 
 def run_scenario(mission: str | Path | dict, seed: int | None = None) -> Scenario:
     run = build_run(mission, seed)
-    return Scenario(run, run.execute())
+    try:
+        return Scenario(run, run.execute())
+    finally:
+        run.stack.close()

@@ -13,15 +13,15 @@ import math
 import mujoco
 import numpy as np
 
-from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.testing.told import told_objects
 
 DROP = 0.001  # m above the surface the object starts, so it settles without a jolt
 
 
-def place_object(run: MissionRun, name: str, x: float, y: float, yaw: float) -> None:
-    """Stand object ``name`` upright at (x, y) on the surface there, turned ``yaw`` rad."""
+def place_object(run: RobotStack, name: str, x: float, y: float, yaw: float) -> None:
+    """Stand object ``name`` upright at (x, y) on the surface there, turned ``yaw`` rad (a stack, or a MissionRun)."""
     if run.sim.time > 0.0:
         raise RuntimeError("place_object is set-up: call it before the run starts")
     surface = map_world_model(run.context.world, run.sim.model).surface_under(np.array([x, y, 10.0]))

@@ -50,10 +50,9 @@ def tell_object_poses(belief: WorldModel, world: WorldConfig, model: mujoco.MjMo
 
 def told_planning_context(world: str = "apartment") -> PlanningContext:
     """A planner's view of ``world`` with every declared object told, from its start pose: language, not sight."""
-    from bt_humanoid.testing.scenario import build_run
+    from bt_humanoid.engine.stack import RobotStack
 
-    run = build_run({"mission": "listen", "world": world, "tree": {"wait": {"seconds": 0}}})
-    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
-    if run.perceiver is not None:
-        run.perceiver.close()
-    return PlanningContext(run.context.world, run.context.world_model, np.zeros(3))
+    stack = RobotStack.load(world, "wheeled_humanoid")
+    stack.close()  # no looking: told, not seen
+    tell_object_poses(stack.context.world_model, stack.world, stack.sim.model)
+    return PlanningContext(stack.world, stack.context.world_model, np.zeros(3))

@@ -12,7 +12,7 @@ from rich.live import Live
 from rich.text import Text
 from rich.tree import Tree
 
-from bt_humanoid.engine.decorators import RecoveryPolicy, SafetyGuard
+from bt_humanoid.engine.decorators import RECOVERY_STEPS, Ask, OrElse, Replan, Retry, SafetyGuard
 from bt_humanoid.engine.executor import Executor
 
 STYLE = {
@@ -23,22 +23,39 @@ STYLE = {
 }
 
 
-def _unwrap(node: Behaviour) -> tuple[Behaviour, SafetyGuard | None, RecoveryPolicy | None]:
-    """The mission node under its Safety and Recovery wrappers."""
-    guard = recovery = None
+def _unwrap(node: Behaviour) -> tuple[Behaviour, SafetyGuard | None, list[Behaviour]]:
+    """The mission node under its Safety guard and recovery steps (an "or else" is a node of its own)."""
+    guard = None
+    steps: list[Behaviour] = []
     if isinstance(node, SafetyGuard):
         guard, node = node, node.decorated
-    if isinstance(node, RecoveryPolicy):
-        recovery, node = node, node.decorated
-    return node, guard, recovery
+    while isinstance(node, RECOVERY_STEPS) and not isinstance(node, OrElse):
+        steps.append(node)
+        node = node.decorated
+    return node, guard, steps
 
 
-def _line(node: Behaviour, guard: SafetyGuard | None, recovery: RecoveryPolicy | None) -> Text:
+def _badges(steps: list[Behaviour]) -> str:
+    """What the recovery steps are doing: retries made, replans made, a question out."""
+    shown = []
+    for step in steps:
+        if isinstance(step, Retry) and step.failures:
+            shown.append(f"↻ {step.failures}/{step.retries}")
+        elif isinstance(step, Replan):
+            used = [f"{b.used}/{b.limit}" for b in step.budgets.values() if b.used]
+            shown += [f"⟲ replan {u}" for u in used]
+        elif isinstance(step, Ask) and step.asking:
+            shown.append("? asking")
+    return "  ".join(shown)
+
+
+def _line(node: Behaviour, guard: SafetyGuard | None, steps: list[Behaviour]) -> Text:
     icon, style = STYLE[node.status]
     text = Text(f"{icon} ", style=style)
     text.append(node.name, style=style if node.status is not Status.INVALID else "")
-    if recovery is not None and recovery.failures:
-        text.append(f"  ↻ {recovery.failures}/{recovery.retries}", style="magenta")
+    badges = _badges(steps)
+    if badges:
+        text.append(f"  {badges}", style="magenta")
     if guard is not None and guard.status is Status.FAILURE and guard.feedback_message.startswith("safety"):
         text.append(f"  ⛔ {guard.feedback_message}", style="bold red")
     elif node.status is Status.RUNNING and node.feedback_message and not node.children:
@@ -50,13 +67,13 @@ def _line(node: Behaviour, guard: SafetyGuard | None, recovery: RecoveryPolicy |
 
 def render_tree(root: Behaviour) -> Tree:
     """A rich Tree of the mission's nodes with status colours, wrappers folded into badges."""
-    node, guard, recovery = _unwrap(root)
-    tree = Tree(_line(node, guard, recovery), guide_style="dim")
+    node, guard, steps = _unwrap(root)
+    tree = Tree(_line(node, guard, steps), guide_style="dim")
 
     def add(branch: Tree, parent: Behaviour) -> None:
         for child in parent.children:
-            inner, child_guard, child_recovery = _unwrap(child)
-            sub = branch.add(_line(inner, child_guard, child_recovery))
+            inner, child_guard, child_steps = _unwrap(child)
+            sub = branch.add(_line(inner, child_guard, child_steps))
             add(sub, inner)
 
     add(tree, node)

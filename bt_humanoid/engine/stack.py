@@ -1,0 +1,140 @@
+"""One robot in one world: the simulation, the robot's controllers, navigator and perceiver, and what it believes.
+
+A stack lives as long as the robot does. Missions come and go on it (``MissionRun(stack, spec)``): a typed
+command is planned from the stack's belief and run on the same stack, an interactive session and a benchmark
+episode run mission after mission on one. Skills see the stack through its SkillContext: the base's motion
+interface, the arm and joint controllers, the navigator, the perceiver and the WorldModel, never the simulator.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from bt_humanoid.control.robot import RobotController
+from bt_humanoid.engine.events import EventLog
+from bt_humanoid.language.plan import PlanningContext
+from bt_humanoid.navigation.navigator import Navigator
+from bt_humanoid.perception.map_knowledge import map_world_model
+from bt_humanoid.perception.perceiver import Perceiver
+from bt_humanoid.perception.safety_scanner import SafetyScanner
+from bt_humanoid.safety.separation import SpeedAndSeparation
+from bt_humanoid.sim.assembly import joint_ranges
+from bt_humanoid.sim.ground_truth import GroundTruth
+from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
+from bt_humanoid.sim.simulation import Simulation
+from bt_humanoid.sim.world_config import WorldConfig, load_world_config
+from bt_humanoid.skills.context import SkillContext
+
+
+class RobotStack:
+    """Builds and holds one robot in one world; ``close()`` when done (the cameras' off-screen contexts)."""
+
+    def __init__(
+        self,
+        world: WorldConfig,
+        robot: RobotConfig,
+        seed: int = 0,
+        speak: Callable[[str], None] | None = None,
+    ) -> None:
+        self.sim = Simulation(world, robot)
+        self.sim.reset(seed)
+        self.robot = RobotController(self.sim)
+        self.navigator = Navigator(self.sim, self.robot, np.array(world.bounds))
+        self.robot.planners.append(self.navigator)
+        self.truth = GroundTruth(self.sim)  # for tests, evaluation and fault injection only: skills never see it
+        self.events = EventLog()  # what the robot did, mission after mission
+        self.said: list[str] = []
+        self.speak = speak
+        #: called after every control period, whichever mission runs (recorders, pacing, fault injection)
+        self.observers: list[Callable[[], None]] = []
+        self.context = SkillContext(
+            robot_config=robot,
+            world=world,
+            joint_ranges=joint_ranges(robot),
+            robot=self.robot,
+            clock=lambda: self.sim.time,
+            speak=self.say,
+            world_model=map_world_model(world, self.sim.model),  # its map, and no objects until the camera sees them
+            navigator=self.navigator,
+        )
+        self.perceiver: Perceiver | None = None
+        if robot.cameras:  # objects are known only once the head camera has seen them
+            camera = next(iter(robot.cameras))
+            self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, "base")
+            self.robot.planners.append(self.perceiver)
+            self.context.perceiver = self.perceiver
+        self.separation = self._separation()
+
+    @classmethod
+    def load(
+        cls,
+        world: str,
+        robot: str,
+        seed: int = 0,
+        robot_start: tuple[float, float, float] | None = None,
+        speak: Callable[[str], None] | None = None,
+    ) -> RobotStack:
+        """A stack of the named world (worlds/) and robot (robots/); ``robot_start`` [x, y, yaw_deg] replaces
+        the world's start pose (test and benchmark set-up)."""
+        world_config = load_world_config(world)
+        if robot_start is not None:
+            world_config = world_config.model_copy(update={"robot_start": tuple(robot_start)})
+        return cls(world_config, load_robot_config(robot), seed, speak)
+
+    @property
+    def world(self) -> WorldConfig:
+        return self.context.world
+
+    @property
+    def robot_config(self) -> RobotConfig:
+        return self.context.robot_config
+
+    def say(self, text: str) -> None:
+        """The robot says something: logged, kept, and spoken when the stack has a voice."""
+        self.said.append(text)
+        self.events.add(self.sim.time, "say", text=text)
+        if self.speak is not None:
+            self.speak(text)
+
+    def look(self) -> None:
+        """One look with the head camera, fused into the belief (robots without a camera know only their map)."""
+        if self.perceiver is not None:
+            self.perceiver.look()
+
+    def planning_context(self) -> PlanningContext:
+        """What a planner may read: the world's names, the robot's belief and where it believes it stands."""
+        return PlanningContext(self.world, self.context.world_model, self.robot.base.pose(), self.robot_config.name)
+
+    def close(self) -> None:
+        if self.perceiver is not None:
+            self.perceiver.close()
+
+    def _separation(self) -> SpeedAndSeparation | None:
+        """Speed and separation monitoring from the base scanner, when the robot has one."""
+        config = self.robot_config
+        if config.scanner is None:
+            return None
+        model = self.sim.model
+        base_body = int(model.jnt_bodyid[model.joint(config.base.joints["yaw"]).id])
+        whole_body = self.robot.whole_body
+
+        def hands() -> list[np.ndarray]:
+            return [whole_body.frame_pose(whole_body.hand_frame(side)).translation for side in config.grippers]
+
+        def zone(name: str, distance: float) -> None:
+            self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))
+
+        separation = SpeedAndSeparation(
+            SafetyScanner(model, self.sim.data, base_body, config.scanner),
+            config.safety,
+            config.base.footprint_radius,
+            config.base.limits.max_speed,
+            furniture=self.navigator.is_furniture,
+            people=lambda: list(self.context.world_model.people.values()),
+            hands=hands,
+            on_zone=zone,
+        )
+        self.robot.monitor_separation(separation)
+        return separation
