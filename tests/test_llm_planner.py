@@ -193,6 +193,7 @@ def test_the_world_summary_is_what_the_robot_believes(context):
     summary = json.loads(world_summary(context))
     assert {o["name"] for o in summary["objects_seen"]} == set(context.world.objects)
     assert summary["surfaces"] == ["table", "counter", "shelf"] and "kitchen" in summary["places"]
+    assert summary["other_names"]["kitchen counter"] == "counter"  # world.yaml's aliases, with what they name
 
 
 def test_bt_plan_uses_the_endpoint_given_on_the_command_line(model, capsys):

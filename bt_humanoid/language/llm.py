@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
+from bt_humanoid.language.vocabulary import WorldVocabulary
 
 ANSWER_SHAPE = """Reply with one JSON object and nothing else, in one of these shapes:
 {"kind": "mission", "say": "<one sentence: what you will do>", "tree": <NODE>}
@@ -237,6 +238,7 @@ def _parse(content: str) -> dict[str, Any]:
 def world_summary(context: PlanningContext) -> str:
     """What the robot knows, as compact JSON: the prompt's world section and part of the cache key."""
     world, belief = context.world, context.belief
+    words = WorldVocabulary.of(world)
     seen = sorted(belief.present(), key=lambda o: o.id)
 
     def surface_of(position: np.ndarray) -> str | None:
@@ -258,6 +260,12 @@ def world_summary(context: PlanningContext) -> str:
         ],
         "objects_known_by_name": {name: f"{d.colour} {d.kind}" for name, d in world.objects.items()},
         "people": {name: person.aliases for name, person in world.people.items()},
+        "other_names": {  # what people may also call an object, place or surface: plan with the name itself
+            alias: name
+            for names in (words.objects, words.places, words.surfaces)
+            for alias, name in names.items()
+            if alias != name.replace("_", " ")
+        },
         "map_bounds": [list(world.bounds[0]), list(world.bounds[1])],
     }
     return json.dumps(summary, sort_keys=True)
