@@ -54,6 +54,12 @@ SNR_DB = 20.0
 BLOCK = RATE // 10  # samples a microphone block holds (100 ms)
 
 
+def _as_read(text: str) -> str:
+    """Words as the planner reads them, without commas: what "heard word for word" compares (a trailing "now"
+    that the grammar heard and the planner leaves out is not a word lost)."""
+    return " ".join(normalise(text).replace(",", " ").split())
+
+
 def streamed(recognizer: CommandRecognizer, clean: np.ndarray, rng: np.random.Generator) -> tuple[Transcript, bool]:
     """What the listener makes of ``clean`` said between two seconds of silence, noise throughout.
 
@@ -126,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
                         three_seconds.append(heard.seconds)
                     got = planned(planner, heard, context)
                     correct += got == expected
-                    verbatim += heard.command == normalise(command["text"]).replace(",", "").replace("  ", " ")
+                    verbatim += _as_read(heard.command) == _as_read(command["text"])
                     if got != expected:
                         misses.append(f"{command['text']!r} ({voice}, {speed} wpm) heard as {heard.text!r}")
                     live, stopped = streamed(recognizer, clean, rng)
