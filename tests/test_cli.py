@@ -2,9 +2,12 @@
 
 import json
 
+import pytest
+
 from bt_humanoid.cli import run_main
 
 
+@pytest.mark.sim
 def test_success_writes_summary_and_events(tmp_path, project_root, capsys):
     summary, events = tmp_path / "s.json", tmp_path / "e.jsonl"
     code = run_main(
@@ -42,6 +45,7 @@ def test_invalid_input_exits_2(tmp_path, capsys):
     assert run_main([str(tmp_path / "absent.yaml")]) == 2
 
 
+@pytest.mark.sim
 def test_record_writes_a_video(tmp_path, project_root):
     import cv2
 

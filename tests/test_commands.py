@@ -51,6 +51,7 @@ def test_the_planner_sees_with_the_camera_and_knows_unseen_things_by_name():
     assert outcome.spec is not None  # known by name: take will look for it
 
 
+@pytest.mark.sim
 def test_a_typed_command_puts_the_red_cube_on_the_counter():
     stack = _looked()
     outcome = plan_command("put the red cube on the counter", stack.planning_context(), lambda question: None)
@@ -64,6 +65,7 @@ def test_a_typed_command_puts_the_red_cube_on_the_counter():
     assert result.speed_at_end < 0.01
 
 
+@pytest.mark.sim
 def test_bt_run_with_a_command_builds_one_simulation_from_first_look_to_last_step(monkeypatch, capsys):
     from bt_humanoid.sim import simulation
 
@@ -93,6 +95,7 @@ def test_bt_run_needs_a_mission_or_a_command(capsys):
     assert "give a mission file, --command TEXT, --audio FILE.wav, --interactive or --listen" in capsys.readouterr().err
 
 
+@pytest.mark.sim
 def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
     stack = _looked()
     context = stack.planning_context()
@@ -116,6 +119,7 @@ def test_a_typed_stop_in_mid_motion_brings_the_robot_to_rest_and_it_says_so():
     assert x < 2.5  # stopped well short of the 3 m it was told to walk
 
 
+@pytest.mark.sim
 def test_an_interactive_session_takes_commands_answers_and_a_stop_on_one_simulation():
     lines: queue.Queue = queue.Queue()
     said: list[str] = []

@@ -23,11 +23,13 @@ def test_fallback_takes_the_first_success():
     assert s.result.tree_status == "SUCCESS" and s.result.said == ["b"]
 
 
+@pytest.mark.sim
 def test_retry_runs_the_child_again():
     s = run({"retry": {"attempts": 3, "child": {"sequence": [{"say": {"text": "try"}}, {"check": {"key": "x"}}]}}})
     assert s.result.tree_status == "FAILURE" and s.result.said == ["try"] * 3
 
 
+@pytest.mark.sim
 def test_repeat_and_blackboard_references():
     s = run(
         {"repeat": {"times": 2, "child": {"say": {"text": "$word"}}}},
@@ -58,12 +60,14 @@ def test_status_flipping_decorators(kind, child_ok, expected):
     assert s.result.tree_status == expected
 
 
+@pytest.mark.sim
 def test_timeout_halts_on_simulation_time():
     s = run({"timeout": {"seconds": 0.5, "child": {"wait": {"seconds": 3}}}})
     assert s.result.tree_status == "FAILURE"
     assert 0.45 <= s.result.sim_time <= 0.7
 
 
+@pytest.mark.sim
 def test_parallel_policies():
     one = run({"parallel": {"policy": "one", "children": [{"wait": {"seconds": 0.2}}, {"wait": {"seconds": 5}}]}})
     assert one.result.tree_status == "SUCCESS" and one.result.sim_time < 0.5
@@ -71,6 +75,7 @@ def test_parallel_policies():
     assert both.result.tree_status == "SUCCESS" and both.result.sim_time >= 1.0
 
 
+@pytest.mark.sim
 def test_guard_halts_the_child_when_its_condition_stops_holding():
     tree = {
         "parallel": {
@@ -86,6 +91,7 @@ def test_guard_halts_the_child_when_its_condition_stops_holding():
     assert [e["new"] for e in leaf(s, "guard.wait")] == ["RUNNING", "INVALID"]
 
 
+@pytest.mark.sim
 def test_reactive_sequence_rechecks_earlier_children():
     tree = {
         "parallel": {
@@ -109,6 +115,7 @@ def test_reactive_sequence_rechecks_earlier_children():
     assert run(memory, blackboard={"ok": True}).result.sim_time >= 1.5
 
 
+@pytest.mark.sim
 def test_recovery_policy_retries_leaves_with_backoff():
     tree = {"sequence": [{"check": {"key": "never", "op": "exists"}, "recovery": {"retries": 2, "backoff": 0.5}}]}
     s = run(tree)

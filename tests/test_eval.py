@@ -157,6 +157,8 @@ def test_summary_counts_what_the_episodes_report():
     assert [f["episode"] for f in figures["failures"]] == [1]
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_the_smoke_suite_runs_end_to_end(tmp_path, capsys):
     out = tmp_path / "smoke.json"
     affinity = os.sched_getaffinity(0)
@@ -171,6 +173,7 @@ def test_the_smoke_suite_runs_end_to_end(tmp_path, capsys):
     assert "success with 95 % confidence interval" in printed and "real-time factor per core" in printed
 
 
+@pytest.mark.slow
 def test_the_ray_backend_runs_episodes_on_a_local_ray_instance():
     ray = pytest.importorskip("ray")
     from bt_humanoid.evaluation.backends import run_ray

@@ -35,6 +35,8 @@ def _fault_time(events: list[dict]) -> float:
     return next(e["t"] for e in events if e["event"] == "fault")
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_an_object_that_slips_out_of_the_fingers_is_grasped_again():
     record, events = _episode("slip")
     assert record["success"], record["failure"]
@@ -43,6 +45,8 @@ def test_an_object_that_slips_out_of_the_fingers_is_grasped_again():
     assert any("slipped out" in message for message in _failures(events)), "the grasp, which checks for itself"
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_an_object_moved_during_the_approach_is_found_where_it_now_is():
     record, events = _episode("target_moved")
     assert record["success"], record["failure"]
@@ -51,23 +55,31 @@ def test_an_object_moved_during_the_approach_is_found_where_it_now_is():
     assert picked and picked[-1] > _fault_time(events), "picked up after it was moved"
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_a_parcel_dropped_on_the_way_is_seen_and_driven_round():
     record, _ = _episode("obstacle_dropped")
     assert record["success"], record["failure"]
     assert not record["collision"]
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_a_shove_while_driving_is_recovered_from():
     record, _ = _episode("push")
     assert record["success"], record["failure"]
     assert not record["collision"]
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_a_camera_that_goes_blind_for_seconds_is_ridden_out():
     record, _ = _episode("blind")
     assert record["success"], record["failure"]
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_a_new_command_mid_mission_stops_the_robot_and_is_done_instead():
     record, events = _episode("new_command")
     assert record["success"], record["failure"]

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -62,6 +63,8 @@ MISSIONS = st.fixed_dictionaries(
 )
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(mission=MISSIONS)
 def test_generated_missions_move_only_within_the_limits(mission: dict):

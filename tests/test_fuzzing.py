@@ -99,6 +99,7 @@ def broken_missions(draw: st.DrawFn) -> tuple[str, str]:
     return how, yaml.safe_dump(mission, sort_keys=False, allow_unicode=True)
 
 
+@pytest.mark.slow
 @settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(broken=broken_missions())
 def test_every_broken_mission_is_exit_2_with_one_clear_line(broken, tmp_path: Path, capsys):
@@ -184,6 +185,7 @@ def planning_context():
     return told_planning_context("apartment")
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(hostile=hostile_plans())
 def test_hostile_plans_are_refused_with_a_reason_or_are_harmless(hostile, planning_context):

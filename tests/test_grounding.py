@@ -109,12 +109,14 @@ def _find(phrase: str, robot_start: tuple[float, float, float] | None = None):
     return run, run.execute()
 
 
+@pytest.mark.sim
 def test_find_grounds_a_phrase_and_remembers_the_object():
     run, result = _find("the cup on the counter")
     assert result.tree_status == "SUCCESS", result.summary()
     assert run.context.blackboard.get("it") == run.context.world_model.object("coffee mug").id
 
 
+@pytest.mark.sim
 def test_find_asks_which_one_when_the_phrase_fits_two():
     _, result = _find("the cube", robot_start=(2.15, 0.0, 0.0))  # west of the table (clear of the box): both cubes
     assert result.tree_status == "FAILURE"

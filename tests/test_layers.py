@@ -72,3 +72,15 @@ def test_the_mission_language_knows_nothing_of_the_engine():
     mission = PACKAGE / "mission"
     for file in mission.rglob("*.py"):
         assert not _imports(file) & {"engine", "safety", "commanding", "cli"}, file
+
+
+def test_skills_and_navigation_see_the_base_through_its_motion_interface():
+    from bt_humanoid.control.base_driver import BaseDriver
+    from bt_humanoid.control.base_motion import BaseMotion
+
+    wanted = [name for name in vars(BaseMotion) if not name.startswith("_")]
+    assert {"pose", "move_to", "track", "brake", "capped", "time"} <= set(wanted)
+    assert all(hasattr(BaseDriver, name) for name in wanted if name != "speed_cap"), "the wheeled base has them all"
+    for package in ("skills", "navigation", "perception", "engine", "language"):
+        for file in (PACKAGE / package).rglob("*.py"):
+            assert "BaseDriver" not in file.read_text(), f"{file.name} reaches past BaseMotion to the wheeled driver"

@@ -1,6 +1,7 @@
 """Pick and place end to end, judged in ground truth: missions, holding while driving, a moved target."""
 
 import numpy as np
+import pytest
 
 from bt_humanoid.paths import project_root
 from bt_humanoid.testing.scenario import Scenario, build_run
@@ -13,6 +14,7 @@ TO_THE_TABLE = [
 ]
 
 
+@pytest.mark.sim
 def test_red_cube_goes_from_the_table_to_the_counter(run_mission):
     scenario = run_mission(MISSIONS / "pick_and_place.yaml")
     assert scenario.result.success, scenario.result.summary()
@@ -22,12 +24,14 @@ def test_red_cube_goes_from_the_table_to_the_counter(run_mission):
     assert scenario.final_speed() < 0.01
 
 
+@pytest.mark.sim
 def test_water_bottle_goes_upright_from_the_table_to_the_counter(run_mission):
     scenario = run_mission(MISSIONS / "pick_and_place_bottle.yaml")
     assert scenario.result.success, scenario.result.summary()
     assert scenario.truth.upright("water bottle")
 
 
+@pytest.mark.sim
 def test_coffee_mug_goes_upright_from_the_counter_to_the_table(run_mission):
     scenario = run_mission(MISSIONS / "pick_and_place_mug.yaml")
     assert scenario.result.success, scenario.result.summary()
@@ -42,6 +46,7 @@ def _offset_in_hand(scenario_run, obj: str) -> np.ndarray:
     return rotation.T @ (scenario_run.truth.object_position(obj) - data.site_xpos[site])
 
 
+@pytest.mark.sim
 def test_held_cube_does_not_slip_while_the_base_drives_and_turns():
     mission = {
         "mission": "hold while driving",
@@ -96,6 +101,7 @@ def _pick_the_cube_while_it_moves(dx: float, dy: float) -> tuple[Scenario, list[
     return Scenario(run, run.execute()), moved
 
 
+@pytest.mark.sim
 def test_target_moved_on_the_table_during_the_approach_is_found_again_and_picked():
     scenario, moved = _pick_the_cube_while_it_moves(-0.1, -0.1)  # 14 cm, still within reach
     assert moved, "the fault was never injected"
@@ -107,6 +113,7 @@ def test_target_moved_on_the_table_during_the_approach_is_found_again_and_picked
     assert scenario.truth.in_hand("red cube") == "right"
 
 
+@pytest.mark.sim
 def test_target_taken_away_during_the_approach_ends_in_a_clear_failure_at_rest():
     scenario, moved = _pick_the_cube_while_it_moves(20.0, 20.0)  # out of the apartment
     assert moved, "the fault was never injected"
@@ -114,10 +121,12 @@ def test_target_taken_away_during_the_approach_ends_in_a_clear_failure_at_rest()
     assert "I do not know where the red cube is now; looked around here and in every place I know" in (
         scenario.result.cause
     )
-    assert scenario.final_speed() < 0.01  # never left stuck RUNNING or moving
+    # it gave up in mid-search: the executor then braked it to rest (never left stuck RUNNING or moving)
+    assert scenario.run.robot.max_speed() < 0.01
     assert scenario.truth.in_hand("red cube") is None
 
 
+@pytest.mark.sim
 def test_fetch_carries_the_mug_from_the_counter_to_the_shelf():
     mission = {
         "mission": "fetch the mug to the shelf",
@@ -132,6 +141,7 @@ def test_fetch_carries_the_mug_from_the_counter_to_the_shelf():
     assert scenario.truth.upright("coffee mug")
 
 
+@pytest.mark.sim
 def test_grasp_moves_a_hand_that_hides_the_object_before_it_looks():
     mug = (8.3, 2.0, 0.945)  # where the world file puts it
     mission = {
@@ -173,6 +183,7 @@ def _give(release_after: float | None, timeout: float) -> tuple[Scenario, list[f
     return Scenario(run, run.execute()), reach
 
 
+@pytest.mark.sim
 def test_give_holds_the_object_out_to_the_person_and_lets_go_after_the_timeout():
     scenario, reach = _give(release_after=None, timeout=1.0)
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
@@ -183,6 +194,7 @@ def test_give_holds_the_object_out_to_the_person_and_lets_go_after_the_timeout()
     assert min(reach) < np.hypot(base[0] - person[0], base[1] - person[1]) - 0.35
 
 
+@pytest.mark.sim
 def test_give_lets_go_as_soon_as_asked():
     scenario, _ = _give(release_after=4.0, timeout=60.0)
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()

@@ -1,6 +1,7 @@
 """The manipulation benchmark's set-up and judging, on a couple of trials (the figures come from running it)."""
 
 import numpy as np
+import pytest
 
 from bt_humanoid.benchmarks.manipulation import OBJECTS, SURFACE, run_trial, sample_trial
 from bt_humanoid.control.stance import stance_for
@@ -38,6 +39,7 @@ def test_sampled_trials_stand_on_the_edge_they_were_drawn_for():
             assert abs(np.degrees(yaw) - trial.start[2]) < 1e-6
 
 
+@pytest.mark.sim
 def test_a_bottle_trial_is_picked_and_placed_upright_and_judged_so():
     run, table = _table()
     trial = sample_trial("bottle", table, np.array(run.context.world.bounds), 0.32, np.random.default_rng(7))

@@ -17,6 +17,7 @@ def test_every_mission_has_a_scenario_test():
     assert {p.name for p in MISSIONS.glob("*.yaml")} == tested
 
 
+@pytest.mark.sim
 def test_demo_drives_around_the_box_to_the_table(run_mission):
     scenario = run_mission(MISSIONS / "demo.yaml")
     assert scenario.result.success, scenario.result.summary()
@@ -31,6 +32,7 @@ def test_demo_drives_around_the_box_to_the_table(run_mission):
     assert scenario.final_speed() < 0.01
 
 
+@pytest.mark.sim
 def test_visit_kitchen_calls_behaviours_and_returns(run_mission):
     scenario = run_mission(MISSIONS / "visit_kitchen.yaml")
     assert scenario.result.success, scenario.result.summary()
@@ -39,6 +41,7 @@ def test_visit_kitchen_calls_behaviours_and_returns(run_mission):
     assert scenario.truth.robot_contacts() == []
 
 
+@pytest.mark.sim
 def test_language_tour_takes_every_branch_it_should(run_mission):
     scenario = run_mission(MISSIONS / "language_tour.yaml")
     assert scenario.result.success, scenario.result.summary()

@@ -30,6 +30,7 @@ def push_joint(run, joint, torque, start=0.3, until=lambda: float("inf")):
     run.executor.observers.append(apply)
 
 
+@pytest.mark.sim
 def test_a_joint_driven_past_its_speed_limit_trips_the_guard():
     run = build_run({"mission": "fast", "tree": {"wait": {"seconds": 4}}})
     push_joint(run, "waist_yaw", 260.0)  # more than the waist actuator's 200 N m: it turns away, ever faster
@@ -38,6 +39,7 @@ def test_a_joint_driven_past_its_speed_limit_trips_the_guard():
     assert result.safety.startswith("joint_limits: joint waist_yaw moving at"), result.safety
 
 
+@pytest.mark.sim
 def test_a_knock_shorter_than_the_overspeed_time_does_not_trip():
     run = build_run({"mission": "knock", "tree": {"wait": {"seconds": 2}}})
     push_joint(run, "waist_yaw", 260.0, start=0.3, until=lambda: 0.4)
@@ -45,6 +47,7 @@ def test_a_knock_shorter_than_the_overspeed_time_does_not_trip():
     assert result.tree_status == "SUCCESS", result.safety
 
 
+@pytest.mark.sim
 def test_a_joint_straining_at_its_torque_limit_halts_its_skill_and_recovery_retries():
     mission = {
         "mission": "strain",
@@ -67,6 +70,7 @@ def test_a_joint_straining_at_its_torque_limit_halts_its_skill_and_recovery_retr
     assert run.robot.at_rest()
 
 
+@pytest.mark.sim
 def test_a_branch_fault_fails_only_the_running_leaf_and_recovery_takes_over():
     run = build_run({"mission": "f", "tree": {"wait": {"seconds": 1.0}, "recovery": {"retries": 1, "backoff": 0.5}}})
     fired = []

@@ -75,6 +75,7 @@ def _watch_contacts(run) -> list:
     return contacts
 
 
+@pytest.mark.sim
 def test_navigate_to_arrives_at_the_kitchen_without_touching_anything():
     run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
     contacts = _watch_contacts(run)
@@ -98,6 +99,7 @@ class _Crawl:
         return "a person close by"
 
 
+@pytest.mark.sim
 def test_a_long_route_held_to_a_crawl_waits_instead_of_failing():
     run = build_run({"mission": "idle", "tree": {"wait": {"seconds": 0}}}, robot_start=(8.0, -3.0, 0.0))
     robot, navigator = run.robot, run.navigator
@@ -109,6 +111,7 @@ def test_a_long_route_held_to_a_crawl_waits_instead_of_failing():
     assert np.hypot(*robot.base.speeds()[:2]) < 0.01
 
 
+@pytest.mark.sim
 def test_a_parcel_dropped_on_the_route_is_seen_and_driven_around():
     run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
     navigator = run.navigator
@@ -153,6 +156,7 @@ def test_what_the_camera_saw_is_forgotten_once_out_of_sight_for_a_while():
     assert grid.centre(rows, cols).tolist() == [[1.55, 1.55]]
 
 
+@pytest.mark.sim
 def test_a_goal_in_the_table_ends_after_bounded_recovery_naming_the_goal(tmp_path, capsys):
     mission = tmp_path / "into_the_table.yaml"
     mission.write_text("mission: drive into the table\ntree:\n  navigate: {pose: [3.4, 0.0, 0]}\n")
@@ -179,6 +183,7 @@ def test_round_robin_runs_the_next_child_each_time():
     assert ran == ["a", "b", "c", "a"]
 
 
+@pytest.mark.sim
 def test_the_tour_visits_every_leg_and_ends_in_the_living_room(run_mission, project_root):
     scenario = run_mission(project_root / "missions" / "tour.yaml")
     assert scenario.result.success, scenario.result.summary()
@@ -187,6 +192,7 @@ def test_the_tour_visits_every_leg_and_ends_in_the_living_room(run_mission, proj
     assert scenario.truth.robot_contacts() == []
 
 
+@pytest.mark.sim
 def test_a_world_can_extend_another_and_add_a_walking_person():
     run = build_run({"mission": "idle", "world": "apartment_busy", "tree": {"wait": {"seconds": 2}}})
     world = run.context.world
@@ -198,6 +204,7 @@ def test_a_world_can_extend_another_and_add_a_walking_person():
     assert not run.navigator.grid.static[run.navigator.grid.cell(start[None, :])].any(), "people are not on the map"
 
 
+@pytest.mark.sim
 def test_a_walker_waits_for_a_robot_in_the_way_then_turns_back():
     """The robot stands on the person's loop: they stop short of it, and after a while walk the loop the other way."""
     mission = {"mission": "in the way", "world": "apartment_busy", "tree": {"wait": {"seconds": 12}}}
@@ -213,6 +220,7 @@ def test_a_walker_waits_for_a_robot_in_the_way_then_turns_back():
     assert not [c for c in contacts if "walker" in c[1]]
 
 
+@pytest.mark.sim
 def test_crossing_the_walking_persons_loop_never_touches_them():
     mission = {"mission": "cross", "world": "apartment_busy", "tree": {"navigate": {"place": "kitchen"}}}
     run = build_run(mission, robot_start=(3.6, -1.5, 0.0))  # south of the table, the person's loop ahead
@@ -229,6 +237,7 @@ def test_crossing_the_walking_persons_loop_never_touches_them():
     assert math.hypot(x - 7.0, y - 2.4) <= 0.05
 
 
+@pytest.mark.sim
 def test_the_small_moves_of_recovery_turn_back_up_and_spin():
     mission = {
         "mission": "small moves",
@@ -270,6 +279,7 @@ def test_back_up_refuses_when_the_map_shows_a_wall_behind():
     assert "no room to back up 0.50 m" in scenario.result.cause
 
 
+@pytest.mark.sim
 def test_an_obstacle_the_camera_finds_gone_is_cleared_from_the_map():
     run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})
     grid = run.navigator.grid
@@ -286,6 +296,7 @@ def test_an_obstacle_the_camera_finds_gone_is_cleared_from_the_map():
     assert cleared and cleared[0] < OBSERVED_MEMORY, "seen free, before it would have been forgotten"
 
 
+@pytest.mark.sim
 def test_a_goal_blocked_only_by_what_the_camera_saw_is_waited_for():
     """Someone stands where the robot is going: it waits for the way to clear instead of failing at once."""
     run = build_run({"mission": "to the kitchen", "tree": {"navigate_to": {"place": "kitchen"}}})

@@ -119,6 +119,7 @@ def test_objects_are_unknown_until_seen_then_fused_over_frames():
     assert belief.object("water bottle").kind == "bottle"  # the world's name for a blue bottle
 
 
+@pytest.mark.sim
 def test_an_object_that_is_gone_loses_confidence_when_its_place_is_in_view():
     run = _camera_run((2.0, 0.0, 0.0))
     run.perceiver.look()
@@ -133,6 +134,7 @@ def test_an_object_that_is_gone_loses_confidence_when_its_place_is_in_view():
         run.context.world_model.object("red cube")
 
 
+@pytest.mark.sim
 def test_find_looks_around_for_an_object_it_has_not_seen():
     run = _camera_run((2.2, -0.9, 120.0), {"find": {"object": "red cube"}})  # the table is off to the right
     result = run.execute()
@@ -142,6 +144,7 @@ def test_find_looks_around_for_an_object_it_has_not_seen():
     assert np.linalg.norm(seen - run.truth.object_centre("red cube")) < 0.01
 
 
+@pytest.mark.sim
 def test_find_says_what_it_could_not_find():
     tree = {"find": {"object": "coffee mug", "search": False}}  # only look around from here
     run = _camera_run((0.0, 3.0, 90.0), tree)  # facing the shelf, the mug elsewhere
@@ -150,6 +153,7 @@ def test_find_says_what_it_could_not_find():
     assert "I have not seen the coffee mug (a white mug) yet; looked around from here" in result.cause
 
 
+@pytest.mark.sim
 def test_find_searches_the_places_for_an_object_in_another_room():
     tree = {"find": {"object": "coffee mug", "remember_as": "mug"}}
     run = _camera_run((0.5, -2.4, -90.0), tree)  # in the living room; the mug is on the kitchen counter

@@ -35,6 +35,7 @@ def test_fields_come_from_the_most_specific_layer_that_sets_them():
     assert resolve_recovery(("node", {}), ("mission", {"retries": None}), robot).steps == RecoverySteps(backoff=0.5)
 
 
+@pytest.mark.sim
 def test_replan_starts_the_enclosing_sequence_over():
     tree = {"sequence": [{"say": {"text": "looking"}}, {**NEVER, "recovery": {"replan": 2, "backoff": 0.5}}]}
     s = run(tree)
@@ -46,6 +47,7 @@ def test_replan_starts_the_enclosing_sequence_over():
     assert replans[1]["t"] - replans[0]["t"] == pytest.approx(0.5, abs=0.06)
 
 
+@pytest.mark.sim
 def test_replan_reaches_the_nearest_sequence_through_decorators_and_fallbacks():
     inner = {"fallback": [{"invert": {"child": {"say": {"text": "plan a"}}}}, {**NEVER, "recovery": {"replan": 1}}]}
     tree = {"sequence": [{"say": {"text": "start"}}, {"sequence": [{"say": {"text": "inner"}}, inner]}]}
@@ -54,6 +56,7 @@ def test_replan_reaches_the_nearest_sequence_through_decorators_and_fallbacks():
     assert [e["node"] for e in events(s, "replan")] == ["sequence[1].sequence"]
 
 
+@pytest.mark.sim
 def test_replan_then_succeeds_when_the_world_changed():
     # the condition holds only after 1.2 s: the third start of the sequence finds it set
     tree = {
@@ -70,6 +73,7 @@ def test_replan_then_succeeds_when_the_world_changed():
     assert 1 <= len(events(s, "replan")) <= 3
 
 
+@pytest.mark.sim
 def test_the_node_setting_wins_and_conditions_ignore_mission_wide_settings():
     tree = {"sequence": [{"say": {"text": "go"}}, {**NEVER, "recovery": {"replan": 1}}]}
     assert run(tree).result.said == ["go", "go"]
@@ -92,6 +96,7 @@ def test_grasp_defaults_to_one_retry_then_one_replan():
     assert [type(step) for step in _steps_above(compiled.nodes[0][0])] == [FaultWatch, SafetyGuard], "no sequence"
 
 
+@pytest.mark.sim
 def test_an_alternative_runs_when_the_node_still_fails():
     tree = {"sequence": [{**NEVER, "recovery": {"retries": 1, "alternative": {"say": {"text": "plan b"}}}}]}
     s = run(tree)
@@ -130,6 +135,7 @@ def ask_run(tree, answers):
     return Scenario(run_, run_.execute()), said
 
 
+@pytest.mark.sim
 def test_ask_tries_again_on_yes_and_fails_on_no():
     tree = {"sequence": [{**NEVER, "recovery": {"retries": 1, "ask": True}}]}
     s, said = ask_run(tree, ["maybe", "yes please", "no"])
@@ -145,6 +151,7 @@ def test_ask_is_skipped_when_no_one_can_answer():
     assert s.result.tree_status == "FAILURE" and events(s, "ask") == []
 
 
+@pytest.mark.sim
 def test_a_stop_while_asking_withdraws_the_question():
     tree = {"sequence": [{**NEVER, "recovery": {"ask": True}}]}
     stack = build_run({"mission": "t", "tree": tree}).stack
@@ -177,6 +184,7 @@ def _steps_above(node):
     return steps
 
 
+@pytest.mark.sim
 def test_the_recovery_example_compiles_as_written_and_runs(run_mission):
     mission = project_root() / "missions" / "recovery.yaml"
     compiled = build_run(mission).compiled
@@ -225,7 +233,7 @@ def test_bt_validate_expand_prints_every_wrapper_with_its_resolved_values(capsys
     assert validate_main(["--expand", str(mission)]) == 0
     out = capsys.readouterr().out
     compiled = build_run(mission).compiled
-    for node, path in compiled.nodes:
+    for _node, path in compiled.nodes:
         if path.endswith(".or_else"):
             assert "or else: the alternative" in out
             continue
@@ -234,7 +242,11 @@ def test_bt_validate_expand_prints_every_wrapper_with_its_resolved_values(capsys
         assert f"retries {steps.retries} ({sources['retries']})" in line and f"replan {steps.replan} (" in line
     guards = sum(1 for node in compiled.root.iterate() if isinstance(node, SafetyGuard))
     assert out.count("safety guard\n") == guards
-    for step, shown in ((Retry, "retry ×"), (Replan, "replan: start this sequence over"), (FaultWatch, "fault watch\n")):
+    for step, shown in (
+        (Retry, "retry ×"),
+        (Replan, "replan: start this sequence over"),
+        (FaultWatch, "fault watch\n"),
+    ):
         count = sum(1 for node in compiled.root.iterate() if isinstance(node, step))
         assert count == 0 or out.count(shown) == count, shown
     limits = MissionLoader().load_file(mission).header.safety

@@ -13,6 +13,7 @@ DRIVE = {
 }
 
 
+@pytest.mark.sim
 def test_stop_request_mid_motion_halts_and_brakes():
     run = build_run(DRIVE)
     executor = run.executor
@@ -35,6 +36,7 @@ def test_stop_request_mid_motion_halts_and_brakes():
     assert any(e["node"].endswith("move_base") for e in halted)
 
 
+@pytest.mark.sim
 @pytest.mark.parametrize("held", [True, False], ids=["feedforward", "without"])
 def test_the_upper_body_is_held_still_while_the_base_brakes(held):
     """The base's deceleration deflects soft joints (head, shoulders); the inertial feedforward cancels it."""
@@ -65,6 +67,7 @@ def test_the_upper_body_is_held_still_while_the_base_brakes(held):
         assert max(deflection) > 0.004
 
 
+@pytest.mark.sim
 def test_time_budget_ends_a_long_mission():
     run = build_run({"mission": "slow", "safety": {"time_budget": 1.0}, "tree": {"wait": {"seconds": 30}}})
     result = run.execute()
@@ -85,6 +88,7 @@ def test_joint_limit_monitor_fires_past_the_margin():
     assert result.safety.startswith("joint_limits") and joint in result.safety
 
 
+@pytest.mark.sim
 def test_safety_failures_are_not_retried():
     mission = {
         "mission": "r",
@@ -97,6 +101,7 @@ def test_safety_failures_are_not_retried():
     assert [e["new"] for e in waits] == ["RUNNING", "INVALID"]
 
 
+@pytest.mark.sim
 def test_driving_into_furniture_is_stopped_at_the_first_touch():
     """A relative move does not steer: straight ahead from the start is the storage box. The bumper stops it."""
     run = build_run({"mission": "blind", "tree": {"move_base": {"x": 3.0, "y": 0.0, "relative": True}}})
@@ -111,13 +116,12 @@ def test_driving_into_furniture_is_stopped_at_the_first_touch():
     assert len(contacts) <= 4  # resting against it, not pushing into it
 
 
+@pytest.mark.sim
 def test_the_arms_may_touch_what_they_work_on():
-    from bt_humanoid.engine.runner import MissionRun
-    from bt_humanoid.mission.loader import MissionLoader
+    from bt_humanoid.engine.runner import run_mission_file
     from bt_humanoid.paths import missions_dir
 
-    run = MissionRun(MissionLoader().load_file(missions_dir() / "pick_and_place.yaml"))
-    result = run.execute()
+    result = run_mission_file(missions_dir() / "pick_and_place.yaml")
     assert result.success, result.cause or result.safety
     assert result.safety is None
 
@@ -136,6 +140,7 @@ def test_workspace_monitor_fires_off_the_map_and_for_a_hand_near_the_floor():
     assert message.startswith("the left hand is 48 cm above the floor")
 
 
+@pytest.mark.sim
 def test_a_relative_move_that_would_leave_the_map_is_refused_before_moving():
     run = build_run({"mission": "away", "tree": {"move_base": {"x": 30.0, "relative": True}}})
     start = run.robot.base.pose()

@@ -84,6 +84,7 @@ def test_furniture_is_muted_but_people_on_the_map_are_not():
 TOWARDS_PERSON = (0.5, -2.0, -90.0)  # 1.7 m north of the person standing in the living room, facing them
 
 
+@pytest.mark.sim
 def test_driving_at_a_person_stops_short_and_the_motion_fails_held():
     """A relative move does not steer round people: the separation monitor stops it before the person."""
     mission = {"mission": "at person", "tree": {"move_base": {"x": 2.5, "y": 0.0, "relative": True}}}
@@ -106,6 +107,7 @@ def test_driving_at_a_person_stops_short_and_the_motion_fails_held():
     assert run.robot.at_rest()
 
 
+@pytest.mark.sim
 def test_a_robot_held_close_to_a_person_may_back_away():
     start = (0.5, -3.7 + 0.32 + 0.14 + 0.1, -90.0)  # 0.1 m from the person's legs, facing them
     mission = {"mission": "back off", "tree": {"move_base": {"x": -1.0, "y": 0.0, "relative": True}}}

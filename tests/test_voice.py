@@ -140,6 +140,7 @@ def test_the_speaker_gets_the_text_as_words_too(tmp_path, monkeypatch):
     assert not (tmp_path / "stray.wav").exists()
 
 
+@pytest.mark.sim
 def test_bt_run_audio_puts_the_red_cube_on_the_counter(tmp_path, capsys):
     wav = synthesize("hey robot, put the red cube on the counter", tmp_path / "command.wav")
     summary = tmp_path / "summary.json"
@@ -154,6 +155,7 @@ def test_bt_run_audio_without_the_wake_word_is_refused_with_exit_2(tmp_path, cap
     assert "no 'hey robot' at the start" in capsys.readouterr().err
 
 
+@pytest.mark.sim
 def test_what_the_robot_says_is_spoken_into_wav_files(tmp_path, capsys):
     speech = tmp_path / "speech"
     demo = project_root() / "missions" / "demo.yaml"
@@ -216,6 +218,7 @@ def test_noise_alone_is_not_heard_as_anything(recognizer):
     assert all(item.kind != "stop" for item in _listen(Listener(recognizer), audio))
 
 
+@pytest.mark.sim
 def test_bt_run_listen_hears_a_command_a_spoken_stop_and_the_next_command(tmp_path, capsys):
     """A WAV file played as a microphone, in real time: the robot sets off, 'stop' stops it, it waves after."""
     quiet = lambda seconds: np.zeros(int(seconds * 16000), dtype=np.int16)  # noqa: E731

@@ -48,6 +48,7 @@ def test_straight_line_from_start_to_table_is_blocked(sim):
     assert hit_body != robot_root
 
 
+@pytest.mark.sim
 def test_objects_rest_where_declared(sim):
     sim.reset()
     truth = GroundTruth(sim)

@@ -103,7 +103,7 @@ def stop_trial(
     stopped at a random moving moment (the last is 0 for a typed stop)."""
     plan = EmbeddedPlanner().plan(command, context)
     stack = RobotStack.load("apartment", "wheeled_humanoid")
-    run = MissionRun(stack, MissionLoader().load_data(plan.mission))
+    run = MissionRun(stack, MissionLoader.for_plans().load_data(plan.mission))
     stop_after = EARLIEST + float(rng.uniform(0.0, 3.0))
     state: dict[str, float] = {}
 

@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
         planned_at = time.perf_counter()
         plan = planner.plan(command["text"], context)
         if plan.mission is not None:
-            MissionLoader().load_data(plan.mission)
+            MissionLoader.for_plans().load_data(plan.mission)
         typed.append(time.perf_counter() - planned_at)
         for voice in VOICES:
             for speed in SPEEDS:

@@ -49,7 +49,7 @@ def wrap_angle(angle: float) -> float:
 
 
 class BaseDriver:
-    """Pose goals for the base, executed through velocity actuators."""
+    """Pose goals for the base, executed through velocity actuators (the wheeled robot's BaseMotion)."""
 
     def __init__(self, io: MujocoRobotIO, config: BaseConfig) -> None:
         self.io = io
@@ -81,6 +81,10 @@ class BaseDriver:
         """The share (0 to 1) of ``velocity`` (vx, vy, yaw rate; world frame) the base may run at now."""
         return self.limiter.share(velocity) if self.limiter is not None else 1.0
 
+    def reset_hold(self) -> None:
+        """A new motion: a protective stop holding it starts counting afresh."""
+        self.held_since = None
+
     def held_too_long(self, share: float, now: float) -> str | None:
         """Track a protective stop; the reason to give up once it has held a motion for the limiter's hold limit."""
         if share >= HELD_SHARE or self.limiter is None:
@@ -90,6 +94,10 @@ class BaseDriver:
         if now - self.held_since <= self.limiter.hold_limit:
             return None
         return f"held {now - self.held_since:.0f} s by a protective stop: {self.limiter.describe()}"
+
+    @property
+    def time(self) -> float:
+        return self.io.time
 
     def pose(self) -> np.ndarray:
         """Odometry: (x, y, yaw) from the base joint encoders."""

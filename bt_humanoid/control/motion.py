@@ -8,6 +8,10 @@ from enum import Enum
 import numpy as np
 from ruckig import ControlInterface, InputParameter, Result, Ruckig, Synchronization, Trajectory
 
+REST_SPEED = 0.01  # m/s or rad/s: below this everywhere, the robot is at rest; a motion has arrived once its
+# joints are on target and this slow (a skill that reports done while its arm still swings leaves a tree that
+# finishes moving)
+
 
 class MotionStatus(Enum):
     RUNNING = "running"

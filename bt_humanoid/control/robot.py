@@ -15,12 +15,11 @@ from bt_humanoid.control.base_driver import BaseDriver, SpeedLimiter
 from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.inertial_feedforward import BaseAccelerationFeedforward
 from bt_humanoid.control.joint_motion import JointReferenceController
+from bt_humanoid.control.motion import REST_SPEED
 from bt_humanoid.control.whole_body import WholeBodyController
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.robot_io import MujocoRobotIO
 from bt_humanoid.sim.simulation import Simulation
-
-REST_SPEED = 0.01  # m/s or rad/s: below this everywhere, the robot is at rest
 
 
 class Planner(Protocol):
@@ -44,7 +43,7 @@ class RobotController:
         self.config: RobotConfig = sim.robot
         base_joints = [self.config.base.joints[axis] for axis in ("x", "y", "yaw")]
         self.body_io = MujocoRobotIO(sim, self.config.actuated_joints)
-        self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)
+        self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)  # skills see its BaseMotion
         self.joints = JointReferenceController(self.body_io, self.config)
         self.grippers = GripperController(self.joints, self.config.grippers)
         io = self.body_io

@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 from ruckig import Trajectory
 
-from bt_humanoid.control.base_driver import BaseDriver
+from bt_humanoid.control.base_motion import BaseMotion
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.motion import MotionHandle, plan_trajectory
 from bt_humanoid.control.wbc import RobotKinematics, solve_ik
@@ -73,7 +73,7 @@ class WholeBodyController:
     def __init__(
         self,
         config: RobotConfig,
-        base: BaseDriver,
+        base: BaseMotion,
         joints: JointReferenceController,
         joint_ranges: dict[str, tuple[float, float]],
     ) -> None:

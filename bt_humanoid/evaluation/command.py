@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -68,12 +69,32 @@ def eval_main(argv: list[str] | None = None) -> int:
     records.sort(key=lambda r: r["episode"])
     figures = summarize(records, wall, args.workers)
     command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
-    figures = {"suite": suite.suite, "file": display_path(file), "seed": seed, "command": command, **figures}
+    figures = {
+        "suite": suite.suite,
+        "file": display_path(file),
+        "seed": seed,
+        "command": command,
+        "commit": source_commit(),
+        **figures,
+    }
     _print(console, figures)
     out = args.json or Path(f"bt-eval-{suite.suite}.json")
     out.write_text(json.dumps({**figures, "episodes": records}, indent=1) + "\n")
     console.print(f"wrote {out}")
     return EXIT_OK
+
+
+def source_commit() -> str | None:
+    """The commit the code was run from ("+ uncommitted changes" when the tree differs); None outside git."""
+    root = Path(__file__).resolve().parents[2]
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True)
+        dirty = subprocess.run(["git", "status", "--porcelain"], cwd=root, capture_output=True, text=True)
+    except OSError:
+        return None
+    if head.returncode != 0:
+        return None
+    return head.stdout.strip() + (" + uncommitted changes" if dirty.stdout.strip() else "")
 
 
 def _print_markdown(saved: Path) -> int:

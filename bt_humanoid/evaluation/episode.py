@@ -196,7 +196,7 @@ def _planned(command: str, suite: Suite, stack: RobotStack, figures: dict):
     if outcome.plan.kind != "mission" or outcome.plan.mission is None:
         return f"planner: {outcome.plan.say}"
     mission = {**outcome.plan.mission, "safety": {"time_budget": suite.time_budget}}
-    return MissionLoader().load_data(mission, name="<command>")
+    return MissionLoader.for_plans().load_data(mission, name="<command>")
 
 
 def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:

@@ -82,7 +82,8 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
 
 
 def markdown(figures: dict[str, Any], command: str) -> str:
-    """The README's results section for one saved run: the command, the rates with intervals, the figures."""
+    """The results section of docs/results.md for one saved run: the command and commit, the rates with
+    intervals, the figures."""
 
     def rate(r: dict[str, Any]) -> str:
         low, high = r["ci95"]
@@ -98,7 +99,8 @@ def markdown(figures: dict[str, Any], command: str) -> str:
     done, latency = figures["time_to_complete_s"], figures["stop_latency_s"]
     lines = [
         f"Suite `{figures['suite']}` ({figures['file']}), seed {figures['seed']}, "
-        f"{figures['success']['episodes']} episodes, measured with",
+        f"{figures['success']['episodes']} episodes, measured at commit {figures.get('commit') or '(not recorded)'} "
+        "with",
         "",
         "```bash",
         command,

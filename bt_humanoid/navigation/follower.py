@@ -6,7 +6,7 @@ for the end of the route under the speed, acceleration and jerk limits, its
 speed capped ahead of every bend so the sideways acceleration stays small;
 the heading turns towards the direction of travel (and to the goal's yaw for
 the last stretch). The base tracks the route point at s through
-``BaseDriver.track``. A base held back by contact falls behind its
+``BaseMotion.track``. A base held back by contact falls behind its
 reference and the motion fails as blocked.
 """
 
@@ -17,7 +17,8 @@ import math
 import numpy as np
 from ruckig import InputParameter, OutputParameter, Result, Ruckig, Synchronization
 
-from bt_humanoid.control.base_driver import BaseDriver, wrap_angle
+from bt_humanoid.control.base_driver import wrap_angle
+from bt_humanoid.control.base_motion import BaseMotion
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.navigation.planner import Route
 from bt_humanoid.sim.robot_config import BaseConfig
@@ -34,7 +35,7 @@ HORIZON = 60.0  # s of travel at the allowed speed that the route timing looks a
 class RouteFollower:
     """One route at a time; ``step()`` every control period while it runs."""
 
-    def __init__(self, base: BaseDriver, config: BaseConfig, dt: float) -> None:
+    def __init__(self, base: BaseMotion, config: BaseConfig, dt: float) -> None:
         self.base = base
         self.config = config
         self.dt = dt
@@ -72,7 +73,7 @@ class RouteFollower:
         self.started_settling: float | None = None
         self.stop_at = None
         self.speed_limit = math.inf
-        self.base.held_since = None
+        self.base.reset_hold()
         self.handle = MotionHandle(f"following a {route.length:.1f} m route", on_cancel=lambda _: self.stop())
         return self.handle
 
@@ -97,7 +98,7 @@ class RouteFollower:
         share = self.base.allowed_share(
             np.array([*(self.max_speed * self._point(route, s)[1]), inp.current_velocity[1]])
         )
-        held = self.base.held_too_long(share, self.base.io.time)
+        held = self.base.held_too_long(share, self.base.time)
         if held is not None:
             handle.fail(held)
             self.handle = None
@@ -180,7 +181,7 @@ class RouteFollower:
             self.route = None
             self.base.track(np.array([*goal, route.goal_yaw]), np.zeros(3))  # hold the goal
             return
-        now = self.base.io.time
+        now = self.base.time
         self.started_settling = self.started_settling if self.started_settling is not None else now
         if now - self.started_settling > SETTLE_TIMEOUT:
             handle.fail(f"stopped {remaining:.2f} m and {math.degrees(yaw_error):.0f}° from the goal")

@@ -123,7 +123,7 @@ class Navigator:
     def step(self) -> None:
         if self.handle is None:
             return  # the map is updated while navigating (scans cost time, and nothing reads it otherwise)
-        now = self.robot.base.io.time
+        now = self.robot.base.time
         if self.camera is not None and now - self.last_scan >= self.scan_period - 1e-9:
             self.last_scan = now
             self._update_map()
@@ -167,7 +167,7 @@ class Navigator:
             route = self._plan()
         except PlanError as error:
             if self._blocked_only_by_what_was_seen():  # a person on the way or at the goal may walk on: wait
-                self._wait(self.robot.base.io.time)
+                self._wait(self.robot.base.time)
                 return
             self._finish_goal(str(error), brake=True)
             return
@@ -300,7 +300,7 @@ class Navigator:
         away_from_camera /= np.maximum(np.hypot(*away_from_camera.T), 1e-6)[:, None]
         depths = np.arange(0.0, SEEN_DEPTH + 1e-9, self.grid.resolution)
         behind = solid[:, None, :] + depths[None, :, None] * away_from_camera[:, None, :]
-        now = self.robot.base.io.time
+        now = self.robot.base.time
         self.grid.mark(behind.reshape(-1, 2), now)
         self.grid.forget_older_than(now - OBSERVED_MEMORY)
         rows, cols = self._cells_seen_free(scan)

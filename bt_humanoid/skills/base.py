@@ -8,10 +8,12 @@ import py_trees
 from py_trees.common import Status
 from pydantic import BaseModel, ValidationError
 
-from bt_humanoid.control.motion import MotionHandle, MotionStatus
+from bt_humanoid.control.motion import REST_SPEED, MotionHandle, MotionStatus
 from bt_humanoid.errors import describe_validation_error
 from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.params import resolve_references
+
+SETTLE_LIMIT = 1.5  # s a moving skill waits, once its motion has ended, for the robot to come to rest
 
 
 class Skill(py_trees.behaviour.Behaviour):
@@ -27,6 +29,9 @@ class Skill(py_trees.behaviour.Behaviour):
     skill_name: ClassVar[str] = ""
     #: branch monitors whose faults this skill notices and handles itself (its guard leaves it running)
     handles_faults: ClassVar[frozenset[str]] = frozenset()
+    #: a skill that moves the robot succeeds once the robot has come to rest (up to SETTLE_LIMIT after its
+    #: motion ended): a tree never reports done while an arm still swings or the base still rolls
+    settles: ClassVar[bool] = False
 
     def __init__(self, name: str, raw_params: dict[str, Any], context: SkillContext, path: str) -> None:
         super().__init__(name=name)
@@ -36,6 +41,7 @@ class Skill(py_trees.behaviour.Behaviour):
         self.params: Any = None
         self.motion: MotionHandle | None = None
         self.error: str | None = None
+        self.done_at: float | None = None  # when the motion ended, while the robot settles
 
     @classmethod
     def check(cls, params: BaseModel, context: CheckContext) -> list[tuple[str, str]]:
@@ -59,7 +65,7 @@ class Skill(py_trees.behaviour.Behaviour):
     # py_trees hooks -------------------------------------------------------
 
     def initialise(self) -> None:
-        self.error, self.motion = None, None
+        self.error, self.motion, self.done_at = None, None, None
         try:
             resolved = resolve_references(self.raw_params, self.context.blackboard)
             self.params = self.Params.model_validate(resolved)
@@ -78,7 +84,15 @@ class Skill(py_trees.behaviour.Behaviour):
         if self.error is not None:
             self.feedback_message = self.error
             return Status.FAILURE
-        return self.poll()
+        status = self.poll()
+        if status is not Status.SUCCESS or not self.settles:
+            return status
+        now = self.context.clock()
+        self.done_at = now if self.done_at is None else self.done_at
+        if self.context.robot.max_speed() >= REST_SPEED and now - self.done_at < SETTLE_LIMIT:
+            self.feedback_message = "settling"
+            return Status.RUNNING
+        return status
 
     def terminate(self, new_status: Status) -> None:
         # halted while running (pre-empted, stopped, timed out): brake what this leaf started

@@ -44,6 +44,7 @@ class MoveBaseParams(StrictModel):
 )
 class MoveBase(Skill):
     Params = MoveBaseParams
+    settles = True
 
     @classmethod
     def check(cls, params: MoveBaseParams, context: CheckContext) -> list[tuple[str, str]]:
@@ -86,6 +87,7 @@ class MoveJointsParams(StrictModel):
 @skill("move_joints", "move joints to a named posture or to joint positions along jerk-limited trajectories")
 class MoveJoints(Skill):
     Params = MoveJointsParams
+    settles = True
 
     @classmethod
     def check(cls, params: MoveJointsParams, context: CheckContext) -> list[tuple[str, str]]:
@@ -115,6 +117,7 @@ class GripperParams(StrictModel):
 @skill("gripper", "open a gripper, or close it until it holds something or shuts")
 class Gripper(Skill):
     Params = GripperParams
+    settles = True
 
     def start(self) -> MotionHandle:
         return self.context.robot.grippers.command(self.params.side, self.params.action)

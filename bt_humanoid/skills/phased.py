@@ -26,6 +26,8 @@ class PhaseFailure(ValueError):
 class PhasedSkill(Skill):
     """Runs ``phases()`` in order; feedback is "phase: progress"."""
 
+    settles = True
+
     def phases(self) -> list[Phase]:
         raise NotImplementedError
 
