@@ -63,6 +63,7 @@ def eval_main(argv: list[str] | None = None) -> int:
             f"bt-eval [bold]{suite.suite}[/]: {episodes} episodes, seed {seed}, "
             f"{args.workers if args.backend == 'local' else 'ray'} worker(s) — {suite.description}"
         )
+        commit = source_commit()  # before the run: the code the episodes ran, whatever is edited meanwhile
         records, wall = _run(str(file.resolve()), list(range(episodes)), seed, args, console)
     except UserError as error:
         return _fail_invalid(error)
@@ -74,7 +75,7 @@ def eval_main(argv: list[str] | None = None) -> int:
         "file": display_path(file),
         "seed": seed,
         "command": command,
-        "commit": source_commit(),
+        "commit": commit,
         **figures,
     }
     _print(console, figures)
