@@ -5,14 +5,14 @@ import pytest
 
 from bt_humanoid.benchmarks.manipulation import OBJECTS, SURFACE, run_trial, sample_trial
 from bt_humanoid.control.stance import stance_for
-from bt_humanoid.testing.scenario import build_run
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.testing.scene import place_object
 from bt_humanoid.testing.told import told_objects
 
 
 def _table():
-    run = build_run({"mission": "probe", "tree": {"wait": {"seconds": 0}}})
-    return run, run.context.world_model.surface(SURFACE)
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    return stack, stack.context.world_model.surface(SURFACE)
 
 
 def test_place_object_moves_the_declared_and_the_simulated_pose_together():

@@ -3,12 +3,12 @@
 from collections.abc import Callable
 
 import pytest
-from pocketsphinx import Jsgf, LogMath
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.language.asr import command_grammar
 from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, british, grammar_words, write_dictionary
 from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.testing.grammar import finite_state_grammar
 
 
 @pytest.fixture(scope="module")
@@ -58,19 +58,8 @@ def test_a_word_the_dictionary_lacks_is_named_with_its_world(tmp_path):
 def accepts(grammar: str, tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], bool]:
     """Whether the grammar's finite-state form (pocketsphinx's own compilation) has a path for some words."""
     folder = tmp_path_factory.mktemp("fsg")
-    (folder / "g.gram").write_text(grammar)
-    jsgf = Jsgf(str(folder / "g.gram"))
-    jsgf.build_fsg(jsgf.get_rule("robot.utterance"), LogMath(), 1.0).writefile(str(folder / "g.fsg"))
-    arcs: dict[int, list[tuple[int, str | None]]] = {}
-    start = final = 0
-    for line in (folder / "g.fsg").read_text().splitlines():
-        fields = line.split()
-        if fields[:1] == ["START_STATE"]:
-            start = int(fields[1])
-        elif fields[:1] == ["FINAL_STATE"]:
-            final = int(fields[1])
-        elif fields[:1] == ["TRANSITION"]:
-            arcs.setdefault(int(fields[1]), []).append((int(fields[2]), fields[4] if len(fields) > 4 else None))
+    fsg = finite_state_grammar(grammar, folder)
+    start, final, arcs = fsg.start, fsg.final, fsg.arcs
 
     def closure(states: set[int]) -> set[int]:
         todo, seen = list(states), set(states)

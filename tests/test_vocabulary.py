@@ -8,7 +8,6 @@ import random
 import shutil
 
 import pytest
-from pocketsphinx import Jsgf, LogMath
 
 from bt_humanoid.language.asr import CommandRecognizer, command_grammar
 from bt_humanoid.language.audio import spoken
@@ -21,6 +20,7 @@ from bt_humanoid.mission.behaviors import BehaviorLibrary
 from bt_humanoid.paths import project_root
 from bt_humanoid.sim.world_config import load_world_config
 from bt_humanoid.skills import REGISTRY
+from bt_humanoid.testing.grammar import finite_state_grammar
 from bt_humanoid.testing.told import told_planning_context
 
 TEA_TIN = """
@@ -108,19 +108,8 @@ def test_aliases_name_places_and_surfaces():
 
 def _sentences(grammar: str, folder, count: int, seed: int = 0) -> list[str]:
     """Random commands the grammar accepts (walks through its finite-state form), without unclear speech."""
-    (folder / "g.gram").write_text(grammar)
-    jsgf = Jsgf(str(folder / "g.gram"))
-    jsgf.build_fsg(jsgf.get_rule("robot.utterance"), LogMath(), 1.0).writefile(str(folder / "g.fsg"))
-    arcs: dict[int, list[tuple[int, str | None]]] = {}
-    start = final = 0
-    for line in (folder / "g.fsg").read_text().splitlines():
-        fields = line.split()
-        if fields[:1] == ["START_STATE"]:
-            start = int(fields[1])
-        elif fields[:1] == ["FINAL_STATE"]:
-            final = int(fields[1])
-        elif fields[:1] == ["TRANSITION"]:
-            arcs.setdefault(int(fields[1]), []).append((int(fields[2]), fields[4] if len(fields) > 4 else None))
+    fsg = finite_state_grammar(grammar, folder)
+    start, final, arcs = fsg.start, fsg.final, fsg.arcs
     rng = random.Random(seed)
     sentences: set[str] = set()
     while len(sentences) < count:

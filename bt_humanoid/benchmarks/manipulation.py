@@ -29,6 +29,7 @@ import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
 from bt_humanoid.control.stance import MAX_DEPTH, stance_for
+from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.testing.scenario import build_run
@@ -215,10 +216,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parse_benchmark_args(parser, argv, "trials")
     rng = np.random.default_rng(args.seed)
-    probe = build_run({"mission": "probe", "tree": {"wait": {"seconds": 0}}})
+    probe = RobotStack.load("apartment", "wheeled_humanoid")  # the apartment's surfaces, for drawing trials
+    probe.close()
     surface = probe.context.world_model.surface(SURFACE)
-    bounds = np.array(probe.context.world.bounds)
-    footprint = probe.context.robot_config.base.footprint_radius
+    bounds = np.array(probe.world.bounds)
+    footprint = probe.robot_config.base.footprint_radius
     print(
         f"bt-humanoid manipulation benchmark: {args.trials} trials per kind, seed {args.seed}, "
         f"perception {args.perception} (one core)"

@@ -1,1 +1,2 @@
-"""Executor, safety/recovery decorators and the event log."""
+"""The engine: a robot stack, a mission run on it (compiler, safety and recovery decorators, executor, verdict),
+and the event log."""

@@ -1,6 +1,6 @@
 """Questions the robot asks a person while a mission runs, and their yes-or-no answers.
 
-A recovery policy with ``ask`` puts a question out and polls for the answer on later ticks (leaves and
+A node's ``ask`` recovery step puts a question out and polls for the answer on later ticks (leaves and
 decorators never block). Whoever hears the person (the interactive session, typed or spoken) hands each
 line to ``answer()`` while a question is out. Runs with no one to ask have no channel at all.
 """

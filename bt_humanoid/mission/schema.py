@@ -208,7 +208,10 @@ def json_schema(behaviors: dict[str, type[BaseModel]]) -> dict[str, Any]:
     kinds |= {k: (model, model.__doc__ or "") for k, model in behaviors.items()}
     extras = {
         "name": (str | None, Field(None, description="label shown in the live tree and the event log")),
-        "recovery": (node_recovery | None, Field(None, description="this node's recovery policy")),
+        "recovery": (
+            node_recovery | None,
+            Field(None, description="this node's recovery: retries, alternative, replan, ask"),
+        ),
     }
     models = [
         create_model(

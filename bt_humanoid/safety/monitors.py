@@ -6,8 +6,8 @@ Two kinds:
   workspace, the time budget). Its first violation latches: every guard then halts its branch, the tree
   fails, and the executor brakes the robot to rest.
 - a **BranchMonitor** sees a fault in what the robot is doing (an object dropped, a joint straining at its
-  torque limit, a skill that makes no progress). The guard of each running leaf it names halts that leaf,
-  which fails with the monitor's reason, and the leaf's recovery policy takes over.
+  torque limit, a skill that makes no progress). The fault watch on each running skill it names halts that
+  skill, which fails with the monitor's reason, and the recovery steps above it take over.
 """
 
 from __future__ import annotations
