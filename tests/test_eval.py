@@ -186,16 +186,19 @@ def test_the_ray_backend_runs_episodes_on_a_local_ray_instance():
     assert records[0]["success"], records[0]["failure"]
 
 
-def test_the_results_section_in_docs_is_generated_from_the_committed_run():
+def test_the_results_sections_in_docs_are_generated_from_the_committed_runs():
     from bt_humanoid.evaluation.report import markdown
 
     root = BENCHMARKS.parents[1]
-    saved = json.loads((root / "results" / "fetch-seed0.json").read_text())
     results = (root / "docs" / "results.md").read_text()
-    begin, end = (
-        "<!-- results:fetch:begin (bt-eval results/fetch-seed0.json --markdown) -->\n",
-        "<!-- results:fetch:end -->",
-    )
-    section = results[results.index(begin) + len(begin) : results.index(end)]
-    assert section == markdown(saved, saved["command"])
-    assert len(saved["episodes"]) == saved["success"]["episodes"] >= 200
+    runs = sorted((root / "results").glob("fetch-seed*.json"))
+    assert [run.name for run in runs][:2] == ["fetch-seed0.json", "fetch-seed1.json"]
+    for run in runs:
+        saved = json.loads(run.read_text())
+        tag = "fetch" if run.stem == "fetch-seed0" else run.stem
+        begin = f"<!-- results:{tag}:begin (bt-eval results/{run.name} --markdown) -->\n"
+        end = f"<!-- results:{tag}:end -->"
+        section = results[results.index(begin) + len(begin) : results.index(end)]
+        assert section == markdown(saved, saved["command"]), run.name
+        assert len(saved["episodes"]) == saved["success"]["episodes"] >= 200
+        assert saved["commit"] and "uncommitted" not in saved["commit"], "a committed run names a clean commit"

@@ -85,12 +85,18 @@ def eval_main(argv: list[str] | None = None) -> int:
     return EXIT_OK
 
 
+RUN_INPUTS = ["bt_humanoid", "behaviors", "missions", "robots", "worlds", "pyproject.toml"]  # what a run is made of
+
+
 def source_commit() -> str | None:
-    """The commit the code was run from ("+ uncommitted changes" when the tree differs); None outside git."""
+    """The commit the code was run from ("+ uncommitted changes" when the code, missions, robots or worlds
+    differ from it; results and docs do not count); None outside git."""
     root = Path(__file__).resolve().parents[2]
     try:
         head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True)
-        dirty = subprocess.run(["git", "status", "--porcelain"], cwd=root, capture_output=True, text=True)
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--", *RUN_INPUTS], cwd=root, capture_output=True, text=True
+        )
     except OSError:
         return None
     if head.returncode != 0:
