@@ -155,3 +155,24 @@ def test_a_transcript_with_unclear_speech_is_refused_but_a_typed_ellipsis_is_not
         assert outcome.plan.kind == "refusal" and outcome.spec is None
         assert "could not make out" in outcome.plan.say
     assert plan_command("pick up the red cube…", context, lambda _: None).plan.kind == "mission"
+
+
+@pytest.mark.sim
+def test_a_result_holds_its_own_missions_events_and_words_not_those_before_it_on_the_stack():
+    from bt_humanoid.testing.scenario import load_mission
+
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    first = MissionRun(
+        stack,
+        load_mission(
+            {"mission": "a", "tree": {"sequence": [{"say": {"text": "one"}}, {"wait": {"seconds": "$missing"}}]}}
+        ),
+    ).execute()
+    assert first.tree_status == "FAILURE" and "missing" in first.cause and first.said == ["one"]
+    second = MissionRun(
+        stack, load_mission({"mission": "b", "safety": {"time_budget": 1.0}, "tree": {"wait": {"seconds": 5}}})
+    ).execute()
+    assert second.said == [] and first.said == ["one"], "each result keeps its own words"
+    assert second.cause is None or "missing" not in second.cause, "not the failure of the mission before"
+    assert [e["mission"] for e in second.events.events if e["event"] == "start"] == ["b"]
+    stack.close()

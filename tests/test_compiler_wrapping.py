@@ -4,9 +4,10 @@ import pytest
 from py_trees.behaviour import Behaviour
 
 from bt_humanoid.cli import _default_args
-from bt_humanoid.engine.decorators import RECOVERY_STEPS, OrElse, SafetyGuard
+from bt_humanoid.engine.decorators import RECOVERY_STEPS, FaultWatch, OrElse, SafetyGuard
 from bt_humanoid.mission.behaviors import BehaviorLibrary
 from bt_humanoid.paths import project_root
+from bt_humanoid.skills.base import Skill
 from bt_humanoid.testing.scenario import build_run
 
 MISSIONS = sorted((project_root() / "missions").glob("*.yaml"))
@@ -20,8 +21,16 @@ def assert_fully_wrapped(root: Behaviour) -> int:
     assert isinstance(root, SafetyGuard), "the root must be a Safety guard"
     checked = 0
     for node in root.iterate():
-        if isinstance(node, (SafetyGuard, *RECOVERY_STEPS)):
+        if isinstance(node, SafetyGuard):
+            alternative = isinstance(node.parent, OrElse) and node.parent.children[1] is node
+            assert node.parent is None or alternative or not isinstance(node.parent, RECOVERY_STEPS), (
+                f"{node.decorated.name}: a recovery step above a Safety guard"
+            )
             continue
+        if isinstance(node, RECOVERY_STEPS):
+            continue
+        if isinstance(node, Skill):
+            assert isinstance(node.parent, FaultWatch), f"{node.name}: a skill without its fault watch"
         child, above = node, node.parent
         while isinstance(above, RECOVERY_STEPS):
             alternative = isinstance(above, OrElse) and above.children[1] is child
@@ -55,5 +64,5 @@ def test_the_check_catches_an_unwrapped_node():
     leaf = guard.decorated.decorated  # safety → faults → wait
     leaf.parent = sequence
     sequence.children[0] = leaf
-    with pytest.raises(AssertionError, match="not wrapped"):
+    with pytest.raises(AssertionError, match="without its fault watch"):
         assert_fully_wrapped(run.compiled.root)

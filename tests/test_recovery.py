@@ -3,7 +3,7 @@
 import pytest
 
 from bt_humanoid.engine.compiler import resolve_recovery
-from bt_humanoid.engine.decorators import Ask, FaultWatch, RecoverySteps, Replan, Retry, SafetyGuard
+from bt_humanoid.engine.decorators import Ask, FaultWatch, OrElse, RecoverySteps, Replan, Retry, SafetyGuard
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.language.questions import Answer, Questions, read_answer
@@ -225,29 +225,36 @@ def test_an_interactive_session_routes_typed_lines_to_the_robots_question():
     assert "Done." in said
 
 
-def test_bt_validate_expand_prints_every_wrapper_with_its_resolved_values(capsys):
+@pytest.mark.parametrize("name", ["pick_and_place.yaml", "recovery.yaml"])
+def test_bt_validate_expand_prints_every_wrapper_with_its_resolved_values(name, capsys):
     from bt_humanoid.cli import validate_main
     from bt_humanoid.mission.loader import MissionLoader
 
-    mission = project_root() / "missions" / "pick_and_place.yaml"
+    mission = project_root() / "missions" / name
     assert validate_main(["--expand", str(mission)]) == 0
     out = capsys.readouterr().out
     compiled = build_run(mission).compiled
     for _node, path in compiled.nodes:
         if path.endswith(".or_else"):
-            assert "or else: the alternative" in out
             continue
         line = next(line for line in out.splitlines() if f"[{path}]" in line)
         steps, sources = compiled.recovery[path].steps, compiled.recovery[path].sources
-        assert f"retries {steps.retries} ({sources['retries']})" in line and f"replan {steps.replan} (" in line
-    guards = sum(1 for node in compiled.root.iterate() if isinstance(node, SafetyGuard))
-    assert out.count("safety guard\n") == guards
-    for step, shown in (
-        (Retry, "retry ×"),
-        (Replan, "replan: start this sequence over"),
-        (FaultWatch, "fault watch\n"),
-    ):
+        assert (
+            f"retries {steps.retries} ({sources['retries']})" in line
+            and f"ask {'yes' if steps.ask else 'no'} (" in line
+        )
+    shown_as = {
+        SafetyGuard: "safety guard\n",
+        Retry: "retry ×",
+        Replan: "replan: start this sequence over",
+        FaultWatch: "fault watch\n",
+        Ask: "ask whether to try",
+        OrElse: "or else: the alternative",
+    }
+    for step, shown in shown_as.items():
         count = sum(1 for node in compiled.root.iterate() if isinstance(node, step))
-        assert count == 0 or out.count(shown) == count, shown
+        assert out.count(shown) == count, shown
     limits = MissionLoader().load_file(mission).header.safety
     assert f"max_base_speed {limits.max_base_speed:g} m/s (from mission safety:)" in out
+    if name == "recovery.yaml":  # it has every kind of step
+        assert all(any(isinstance(node, step) for node in compiled.root.iterate()) for step in shown_as)

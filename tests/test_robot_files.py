@@ -24,6 +24,7 @@ def test_each_robot_folder_has_a_scene_and_a_readme(folder):
     assert (folder / "README.md").is_file()
 
 
+@pytest.mark.sim
 @pytest.mark.parametrize("scene", sorted(ROBOTS.glob(f"*/{SCENE_FILE}")), ids=lambda p: p.parent.name)
 def test_scene_loads_as_it_is_with_the_robot_on_a_floor(scene):
     model = mujoco.MjModel.from_xml_path(str(scene))  # what python -m mujoco.viewer --mjcf does

@@ -98,6 +98,7 @@ def bench_demo_rtf(repeats: int = 3) -> dict:
     for _ in range(repeats):
         run = build_run(missions_dir() / "demo.yaml")
         result = run.execute()
+        run.stack.close()  # its cameras' off-screen contexts: one per run adds up over a benchmark
         assert result.success, result.summary()
         factors.append(result.real_time_factor)
         sim_times.append(result.sim_time)

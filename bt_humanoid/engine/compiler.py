@@ -136,15 +136,16 @@ class Compiler:
         wrapped = inner
         if node.category == "skill":
             wrapped = FaultWatch("faults", wrapped, supervisor)
+        if steps.retries:
+            wrapped = self._logged(Retry(wrapped, node.path, steps.retries, steps.backoff, clock, supervisor))
         if isinstance(inner, py_trees.composites.Sequence) and node.category != "behavior":
-            # this sequence starts over for the nodes below it that may replan (up to the next sequence down)
+            # this sequence starts over for the nodes below it that may replan (up to the next sequence down),
+            # once its own retries are spent (outside them, so a retry does not renew the replans)
             claimed, self.replanning[below:] = self.replanning[below:], []
             if claimed:
                 wrapped = self._logged(Replan(wrapped, node.path, what, steps.backoff, clock, supervisor))
                 for top, budget in claimed:
                     wrapped.watch(top, budget)
-        if steps.retries:
-            wrapped = self._logged(Retry(wrapped, node.path, steps.retries, steps.backoff, clock, supervisor))
         alternative = self._alternative_for(node)
         if alternative is not None:
             wrapped = OrElse(what, wrapped, self._wrapped(alternative))

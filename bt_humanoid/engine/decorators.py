@@ -5,8 +5,8 @@ Each node of a mission is compiled as (outermost first)::
     safety            SafetyGuard: a violation halts the branch; never recovered
       ask             Ask: once all else failed, ask the person whether to try again (someone can answer)
         or else       OrElse: the node (with its retries), else its alternative
-          retry       Retry: the same node again, ``backoff`` seconds apart
-            replan    Replan (on a sequence): start the sequence over when a node below it that may replan failed
+          replan      Replan (on a sequence): start the sequence over when a node below it that may replan failed
+            retry     Retry: the same node again, ``backoff`` seconds apart
               faults  FaultWatch (on a skill): a branch monitor's fault halts the skill, which fails with its reason
                 node
 
@@ -248,8 +248,8 @@ class Ask(_Recovery):
         self.asking = False
 
     def tick(self) -> Iterator[Behaviour]:
-        if self.asking:
-            answer = self.questions.take() if self.questions is not None else Answer.NO
+        if self.asking and self.questions is not None:
+            answer = self.questions.take()
             if answer is None:
                 yield self
                 return

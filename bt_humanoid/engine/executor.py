@@ -14,6 +14,7 @@ from collections.abc import Callable
 from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
+from bt_humanoid.control.motion import REST_SPEED
 from bt_humanoid.control.robot import RobotController
 from bt_humanoid.engine.compiler import CompiledMission
 from bt_humanoid.engine.events import EventLog
@@ -135,4 +136,4 @@ class Executor:
         while not self.robot.at_rest() and self.sim.time < deadline:
             self.advance(self.steps_per_control * self.sim.timestep)
         speed = self.robot.max_speed()
-        self.events.add(self.sim.time, "rest" if speed < 0.01 else "moving", max_speed=round(speed, 4))
+        self.events.add(self.sim.time, "rest" if speed < REST_SPEED else "moving", max_speed=round(speed, 4))

@@ -99,8 +99,6 @@ class MissionRun:
         self.stack, self.spec = stack, spec
         robot_config = stack.robot_config
         self.limits = resolve_safety(header.safety, robot_config.safety)
-        stack.context.blackboard = Blackboard(header.blackboard)
-        stack.robot.base.speed_cap = self.limits.max_base_speed.value
         self.time_budget = self.limits.time_budget.value
         defaults = robot_config.safety
         self.stop_monitor = StopRequestMonitor()
@@ -169,12 +167,21 @@ class MissionRun:
             self.robot.brake()
 
     def execute(self) -> RunResult:
-        """Run the mission to its end and the robot to rest; the stack stays open for the next mission."""
+        """Run the mission to its end and the robot to rest; the stack stays open for the next mission.
+
+        The result holds this mission's events and words only, not those of missions run before on the stack.
+        """
         started = time.perf_counter()
+        stack = self.stack
+        stack.context.blackboard = Blackboard(self.spec.header.blackboard)  # this mission's, from its start
+        stack.robot.base.speed_cap = self.limits.max_base_speed.value
+        first_event, first_said = len(stack.events.events), len(stack.said)
         status = self.executor.run(max_time=self.sim.time + self.time_budget + 1.0)
         if self.stop_monitor.reason is not None:
-            self.stack.say("I have stopped.")  # at rest now: executor.run brakes to rest before it returns
+            stack.say("I have stopped.")  # at rest now: executor.run brakes to rest before it returns
         wall = time.perf_counter() - started
+        events = EventLog()
+        events.events = stack.events.events[first_event:]
         conditions = [check_condition(c, self.truth) for c in self.spec.header.success]
         violation = self.supervisor.violation
         tree_status = status.name if status is not Status.INVALID else "FAILURE"
@@ -184,17 +191,17 @@ class MissionRun:
             conditions=conditions,
             sim_time=self.sim.time,
             wall_time=wall,
-            events=self.events,
-            said=self.said,
+            events=events,
+            said=stack.said[first_said:],
             safety=f"{violation.monitor}: {violation.message}" if violation else None,
-            cause=self._failure_cause() if tree_status == "FAILURE" else None,
+            cause=self._failure_cause(events) if tree_status == "FAILURE" else None,
             speed_at_end=self.executor.speed_at_end,
         )
 
-    def _failure_cause(self) -> str | None:
+    def _failure_cause(self, events: EventLog) -> str | None:
         """``path: reason`` of the last skill that failed (a decorator's own message says less)."""
         skills = {path for node, path in self.compiled.nodes if isinstance(node, Skill)}
-        for event in reversed(self.events.events):
+        for event in reversed(events.events):
             if event["event"] == "status" and event["new"] == "FAILURE" and event["node"] in skills:
                 return f"{event['node']}: {event.get('feedback') or 'failed'}"
         return None

@@ -21,6 +21,7 @@ import numpy as np
 
 from bt_humanoid.benchmarks.navigation import free_start
 from bt_humanoid.commanding import plan_command
+from bt_humanoid.control.motion import REST_SPEED
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.engine.verdict import check_condition
@@ -30,8 +31,6 @@ from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
 from bt_humanoid.testing.scene import place_object
-
-AT_REST = 0.01  # m/s or rad/s: faster than this when the tree finishes counts as still moving
 
 
 @cache
@@ -252,9 +251,9 @@ def _verdict(
         "sim_time": round(run.sim.time, 3),
         "person_contacts": len(touched or []),
         "collision": bool(result is not None and result.safety and result.safety.startswith("collision")),
-        "ended_moving": finish_speed >= AT_REST and not (result is not None and result.safety),
+        "ended_moving": finish_speed >= REST_SPEED and not (result is not None and result.safety),
         "speed_at_finish": round(finish_speed, 4),
-        "moving_after_brake": speed >= AT_REST,
+        "moving_after_brake": speed >= REST_SPEED,
         "final_speed": round(speed, 4),
         "plan_ms": figures["plan_ms"],
         "stop_latency_s": figures["stop_latency_s"],
