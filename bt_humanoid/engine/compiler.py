@@ -161,8 +161,7 @@ class Compiler:
         return guard
 
     def _logged(self, step):
-        if self.log is not None:
-            step.log = self.log
+        step.log = self.log
         return step
 
     def _build(self, node: NodeSpec) -> Behaviour:

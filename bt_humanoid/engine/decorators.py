@@ -31,10 +31,6 @@ from bt_humanoid.safety.monitors import SafetySupervisor
 RecoveryLog = Callable[[str, str, str], None]
 
 
-def _no_log(path: str, action: str, message: str) -> None:
-    """What a decorator reports to when nobody listens."""
-
-
 @dataclass(frozen=True)
 class RecoverySteps:
     """A node's recovery, resolved by the compiler from the node, the mission, the skill and the robot."""
@@ -128,7 +124,7 @@ class _Recovery(py_trees.decorators.Decorator):
         self.path = path
         self.clock = clock
         self.supervisor = supervisor
-        self.log: RecoveryLog = _no_log
+        self.log: RecoveryLog | None = None  # the event log's entry point, set by the compiler
         self.waiting_until: float | None = None
 
     def tick(self) -> Iterator[Behaviour]:
@@ -148,7 +144,8 @@ class _Recovery(py_trees.decorators.Decorator):
 
     def report(self, action: str, message: str) -> None:
         self.feedback_message = message
-        self.log(self.path, action, message)
+        if self.log is not None:
+            self.log(self.path, action, message)
 
 
 class Retry(_Recovery):

@@ -13,9 +13,6 @@ class Setting:
     value: float
     source: str  # where the value came from: "mission safety:" or "robot.yaml safety:"
 
-    def __str__(self) -> str:
-        return f"{self.value:g} (from {self.source})"
-
 
 @dataclass(frozen=True)
 class SafetyLimits:
