@@ -17,6 +17,7 @@ import mujoco
 import numpy as np
 
 from bt_humanoid.sim.robot_config import RobotConfig
+from bt_humanoid.sim.scene_objects import PlacedObject, add_objects
 from bt_humanoid.sim.world_config import Walker, WorldConfig
 
 _EMPTY_PREFIX_WARNING = "Attaching a spec with an empty prefix"
@@ -50,11 +51,12 @@ def robot_spec(config: RobotConfig) -> mujoco.MjSpec:
     return lower
 
 
-def world_spec(world: WorldConfig, robot: RobotConfig) -> mujoco.MjSpec:
-    """The scene with the robot attached at the world origin."""
+def world_spec(world: WorldConfig, robot: RobotConfig, objects: list[PlacedObject] | None = None) -> mujoco.MjSpec:
+    """The world's model with the scene's objects in it and the robot attached at the origin."""
     scene = mujoco.MjSpec.from_file(str(world.model_path))
     for body, walker in world.walkers.items():
         _add_walker(scene, body, walker)
+    add_objects(scene, world, objects or [])
     frame = scene.worldbody.add_frame()
     with _quiet_empty_prefix_warning():
         scene.attach(robot_spec(robot), frame=frame, prefix="")

@@ -25,7 +25,7 @@ class GroundTruth:
         self.robot_bodies = sim.robot_bodies
 
     def _object_body(self, name: str) -> int:
-        return self.model.body(self.sim.world.objects[name].body).id
+        return self.model.body(self.sim.object_bodies[name]).id
 
     def object_position(self, name: str) -> np.ndarray:
         return self.data.xpos[self._object_body(name)].copy()

@@ -17,6 +17,8 @@ import numpy as np
 
 from bt_humanoid.sim.assembly import world_spec
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
+from bt_humanoid.sim.scene_config import SceneConfig, load_scene, start_pose
+from bt_humanoid.sim.scene_objects import place_scene, surface_tops
 from bt_humanoid.sim.walkers import WalkerDriver
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 
@@ -24,10 +26,20 @@ from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 class Simulation:
     """One robot in one world, stepped on simulation time."""
 
-    def __init__(self, world: WorldConfig, robot: RobotConfig) -> None:
+    def __init__(self, world: WorldConfig, robot: RobotConfig, scene: SceneConfig | None = None) -> None:
         self.world = world
         self.robot = robot
-        self.spec = world_spec(world, robot)
+        if scene is None and world.scene is not None:
+            scene = load_scene(world, world.scene)
+        self.scene = scene
+        placed = place_scene(world, scene, surface_tops(world)) if scene is not None else []
+        #: every object of the run by its name ("coke 2") → its body; the world's fixed objects and the scene's
+        self.object_bodies = {name: o.body for name, o in world.objects.items() if o.body is not None}
+        self.object_bodies |= {p.name: p.body for p in placed}
+        #: and → the world object it is one of ("coke 2" → "coke"; a fixed object is itself)
+        self.object_kinds = {name: name for name, o in world.objects.items() if o.body is not None}
+        self.object_kinds |= {p.name: p.object for p in placed}
+        self.spec = world_spec(world, robot, placed)
         self.model = self.spec.compile()
         self.data = mujoco.MjData(self.model)
         self.timestep = float(self.model.opt.timestep)
@@ -41,8 +53,10 @@ class Simulation:
         self.reset()
 
     @classmethod
-    def load(cls, world: str, robot: str) -> Simulation:
-        return cls(load_world_config(world), load_robot_config(robot))
+    def load(cls, world: str, robot: str, scene: str | None = None) -> Simulation:
+        """By names (and a scene by name or path; none: the world's own scene, if it has one)."""
+        config = load_world_config(world)
+        return cls(config, load_robot_config(robot), load_scene(config, scene) if scene is not None else None)
 
     @property
     def time(self) -> float:
@@ -51,7 +65,7 @@ class Simulation:
     def reset(self, seed: int = 0) -> None:
         """Initial state: robot at the world's start pose in its home posture, actuators holding it."""
         mujoco.mj_resetData(self.model, self.data)
-        x, y, yaw_deg = self.world.robot_start
+        x, y, yaw_deg = start_pose(self.scene, self.world)
         base = self.robot.base.joints
         self.set_initial_joint(base["x"], x)
         self.set_initial_joint(base["y"], y)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.paths import worlds_dir
@@ -32,12 +32,49 @@ class Surface(StrictModel):
     aliases: list[str] = Field(default_factory=list, description=ALIASES)
 
 
+class Cap(StrictModel):
+    """A bottle's cap: a small cylinder on top of its body."""
+
+    diameter: float = Field(gt=0, le=0.1, description="m")
+    height: float = Field(gt=0, le=0.1, description="m")
+    rgba: tuple[float, float, float, float] = (0.9, 0.9, 0.9, 1.0)
+
+
+class ObjectModel(StrictModel):
+    """How to build one of an object: scenes place as many as they like (worlds/<world>/scenes/)."""
+
+    shape: Literal["cylinder", "box", "sphere"]
+    size: tuple[float, float, float] = Field(
+        description="full extents along x, y and up (m); a cylinder's x is its diameter"
+    )
+    mass: float = Field(gt=0, le=5.0, description="kg")
+    texture: str | None = Field(
+        None, description="PNG in the world's textures/ folder: wrapped round a cylinder, on every face of a box"
+    )
+    rgba: tuple[float, float, float, float] = (1.0, 1.0, 1.0, 1.0)
+    friction: float = Field(1.0, gt=0, le=2.0)
+    cap: Cap | None = None
+
+
 class WorldObject(StrictModel):
-    body: str
-    kind: str
+    """A thing people can ask for: either one body of the world's model, or a model that scenes place."""
+
+    body: str | None = Field(None, description="the body in the world's MJCF (objects built by scenes have none)")
+    model: ObjectModel | None = None
+    kind: str = Field(description="its shape for grasping: cube, box, can, bottle, mug, ball, bag, bar, ...")
     colour: str
     upright: bool = False
     aliases: list[str] = Field(default_factory=list, description=ALIASES)
+    categories: list[str] = Field(
+        default_factory=list,
+        description="what kind of thing it is and what it is good for, as people say it: drink, snack, recyclable, ...",
+    )
+
+    @model_validator(mode="after")
+    def _body_or_model(self) -> WorldObject:
+        if (self.body is None) == (self.model is None):
+            raise ValueError("give either body (a body of the world's MJCF) or model (built by scenes), not both")
+        return self
 
 
 class Person(StrictModel):
@@ -53,6 +90,19 @@ class Walker(StrictModel):
     radius: float = Field(0.2, gt=0, le=0.5, description="body radius (m)")
 
 
+class Container(StrictModel):
+    """An open bin things are dropped into: the opening is a rectangle at the top of its walls."""
+
+    body: str = Field(description="the bin's body in the world's MJCF")
+    place: str = Field(description="the place the robot stands at to drop things in")
+    opening: Region = Field(description="[[x_min, y_min], [x_max, y_max]] inside its walls (m, world)")
+    height: float = Field(gt=0, le=1.5, description="m: the top of its walls")
+    takes: list[str] = Field(
+        default_factory=list, description="categories it is for (recyclable, compostable); none: anything"
+    )
+    aliases: list[str] = Field(default_factory=list, description=ALIASES)
+
+
 class WorldConfig(StrictModel):
     name: str
     description: str = ""
@@ -65,6 +115,8 @@ class WorldConfig(StrictModel):
     people: dict[str, Person] = Field(default_factory=dict)
     obstacles: list[str] = Field(default_factory=list)
     walkers: dict[str, Walker] = Field(default_factory=dict)  # body name → how they walk
+    containers: dict[str, Container] = Field(default_factory=dict)
+    scene: str | None = Field(None, description="the scene (scenes/NAME.yaml) a run starts from unless told another")
     folder: Path = Path()
 
     @property

@@ -1,0 +1,157 @@
+"""Build a scene's objects into a world's model: bodies from world.yaml's models, where the scene puts them.
+
+Each placement becomes a free body on its surface, named after its object
+("coke"; a second coke is "coke 2", body ``coke_2``). Its first geom is the
+object's body (grasps close on it), a bottle's cap a second one. Spots a scene
+leaves out are drawn from its seed: inside the surface's edge and clear of the
+other objects. All of this is set-up, before the first simulation step.
+"""
+
+from __future__ import annotations
+
+import math
+import unicodedata
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from bt_humanoid.sim.scene_config import SceneConfig
+from bt_humanoid.sim.world_config import ObjectModel, WorldConfig
+
+EDGE_MARGIN = 0.08  # m between a drawn spot and the surface's edge
+GAP = 0.03  # m between the footprints of drawn spots
+DROP = 0.001  # m above the surface: the object settles onto it in the first steps
+ATTEMPTS = 500
+
+
+@dataclass(frozen=True)
+class PlacedObject:
+    """One object of a scene, placed: its name in the run, its model's name, its body, where and how turned."""
+
+    name: str  # "coke", "coke 2"
+    object: str  # the world's object it is one of ("coke")
+    body: str  # MJCF body name ("coke_2")
+    position: np.ndarray  # centre of its main geom (world, m)
+    yaw: float  # rad
+
+
+def body_name(name: str) -> str:
+    """An ASCII MJCF name for an object's name: "jalapeño chips 2" → "jalapeno_chips_2"."""
+    folded = unicodedata.normalize("NFKD", name).encode("ascii", "ignore").decode()
+    return "".join(c if c.isalnum() else "_" for c in folded)
+
+
+def footprint_radius(model: ObjectModel) -> float:
+    """Half the diagonal of the object's footprint: the circle it may sweep when turned."""
+    return 0.5 * math.hypot(model.size[0], model.size[1]) if model.shape == "box" else 0.5 * model.size[0]
+
+
+def place_scene(
+    world: WorldConfig, scene: SceneConfig, surface_tops: dict[str, tuple[np.ndarray, float]]
+) -> list[PlacedObject]:
+    """Where each of the scene's objects stands. ``surface_tops``: surface → ([[x0, y0], [x1, y1]], top z)."""
+    rng = np.random.default_rng(scene.seed)
+    counts: dict[str, int] = {}
+    placed: list[PlacedObject] = []
+    for placement in scene.objects:
+        model = world.objects[placement.object].model
+        assert model is not None  # checked when the scene was loaded
+        region, top = surface_tops[placement.on]
+        radius = footprint_radius(model)
+        if placement.at is not None:
+            xy = (region[0] + region[1]) / 2 + np.array(placement.at)
+        else:
+            xy = _free_spot(region, radius, [(p.position[:2], _radius(world, p)) for p in placed], rng)
+        yaw = math.radians(placement.yaw) if placement.yaw is not None else float(rng.uniform(-math.pi, math.pi))
+        counts[placement.object] = counts.get(placement.object, 0) + 1
+        number = counts[placement.object]
+        name = placement.object if number == 1 else f"{placement.object} {number}"
+        position = np.array([xy[0], xy[1], top + model.size[2] / 2 + DROP])
+        placed.append(PlacedObject(name, placement.object, body_name(name), position, yaw))
+    return placed
+
+
+def _radius(world: WorldConfig, placed: PlacedObject) -> float:
+    model = world.objects[placed.object].model
+    assert model is not None
+    return footprint_radius(model)
+
+
+def _free_spot(
+    region: np.ndarray, radius: float, others: list[tuple[np.ndarray, float]], rng: np.random.Generator
+) -> np.ndarray:
+    low, high = region[0] + EDGE_MARGIN + radius, region[1] - EDGE_MARGIN - radius
+    for _ in range(ATTEMPTS):
+        spot = rng.uniform(low, high)
+        if all(np.hypot(*(spot - xy)) >= radius + r + GAP for xy, r in others):
+            return spot
+    raise ValueError("no free spot left on the surface: too many objects for it")
+
+
+def add_objects(spec: mujoco.MjSpec, world: WorldConfig, objects: list[PlacedObject]) -> None:
+    """Add each placed object as a free body, with its model's textured material."""
+    materials: dict[str, str] = {}
+    for placed in objects:
+        model = world.objects[placed.object].model
+        assert model is not None
+        if placed.object not in materials:
+            materials[placed.object] = _material(spec, world, placed.object, model)
+        yaw = placed.yaw
+        body = spec.worldbody.add_body(
+            name=placed.body, pos=placed.position, quat=[math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+        )
+        body.add_freejoint(name=placed.body)
+        geom = dict(
+            contype=1,
+            conaffinity=1,
+            condim=4,
+            friction=[model.friction, 0.01, 0.001],
+            solref=[0.004, 1.0],
+            material=materials[placed.object],
+        )
+        half = np.array(model.size) / 2
+        if model.shape == "cylinder":
+            shape, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [half[0], half[2], 0.0]
+        elif model.shape == "box":
+            shape, size = mujoco.mjtGeom.mjGEOM_BOX, list(half)
+        else:
+            shape, size = mujoco.mjtGeom.mjGEOM_SPHERE, [half[0], 0.0, 0.0]
+        cap = model.cap
+        body_mass = model.mass * (0.97 if cap else 1.0)
+        body.add_geom(name=placed.body, type=shape, size=size, mass=body_mass, **geom)
+        if cap is not None:
+            body.add_geom(
+                name=f"{placed.body}_cap",
+                type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                size=[cap.diameter / 2, cap.height / 2, 0.0],
+                pos=[0.0, 0.0, half[2] + cap.height / 2],
+                mass=model.mass * 0.03,
+                rgba=list(cap.rgba),
+                **{k: v for k, v in geom.items() if k != "material"},
+            )
+
+
+def _material(spec: mujoco.MjSpec, world: WorldConfig, name: str, model: ObjectModel) -> str:
+    material = spec.add_material(name=f"{body_name(name)}_look", rgba=list(model.rgba))
+    if model.texture is not None:
+        texture = spec.add_texture(
+            name=f"{body_name(name)}_label",
+            type=mujoco.mjtTexture.mjTEXTURE_2D,
+            file=str(world.folder / "textures" / model.texture),
+        )
+        material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = texture.name
+    return material.name
+
+
+def surface_tops(world: WorldConfig) -> dict[str, tuple[np.ndarray, float]]:
+    """Each surface's rectangle ([[x0, y0], [x1, y1]]) and top height, from the world's model (furniture only)."""
+    model = mujoco.MjModel.from_xml_path(str(world.model_path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    tops = {}
+    for name, surface in world.surfaces.items():
+        geom = model.geom(surface.geom).id
+        centre, half = data.geom_xpos[geom], model.geom_size[geom]  # furniture tops are unrotated boxes
+        tops[name] = (np.array([centre[:2] - half[:2], centre[:2] + half[:2]]), float(centre[2] + half[2]))
+    return tops
