@@ -157,5 +157,5 @@ def test_the_scene_graph_says_what_stands_where():
 
 def belief_of_apartment():
     run = build_run({"mission": "words", "tree": {"wait": {"seconds": 0}}})
-    tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
+    tell_object_poses(run.context.world_model, run.sim)
     return run.context.world_model

@@ -18,7 +18,7 @@ def _table():
 def test_place_object_moves_the_declared_and_the_simulated_pose_together():
     run, table = _table()
     place_object(run, "water bottle", 3.6, -0.2, 0.7)
-    belief = next(o for o in told_objects(run.context.world, run.sim.model) if o.name == "water bottle")
+    belief = next(o for o in told_objects(run.sim) if o.name == "water bottle")
     truth = run.truth.object_position("water bottle")
     assert np.allclose(belief.position[:2], [3.6, -0.2]) and np.allclose(truth[:2], [3.6, -0.2], atol=1e-6)
     assert abs(belief.bottom - table.height) < 0.002

@@ -133,7 +133,7 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
             place_object(run, other, *next(parking), 0.0)
     place_object(run, name, *trial.spot, trial.yaw)
     if perception == "told":  # control alone: the robot is told where everything is (the camera still looks)
-        tell_object_poses(run.context.world_model, run.context.world, run.sim.model)
+        tell_object_poses(run.context.world_model, run.sim)
     grasped: list[bool] = []
 
     def on_event(event: dict) -> None:

@@ -101,7 +101,7 @@ def build_scene(rng: np.random.Generator):
             spot = spots[chosen.index(name)]
             place_object(run, name, spot[0], spot[1], float(rng.uniform(-math.pi, math.pi)))
             colour = str(rng.choice(list(PALETTE)))
-            body = model.body(run.context.world.objects[name].body).id
+            body = model.body(run.sim.object_bodies[name]).id
             for geom in range(model.body_geomadr[body], model.body_geomadr[body] + model.body_geomnum[body]):
                 model.geom_rgba[geom, :3] = PALETTE[colour]
             colours[name] = colour
@@ -151,7 +151,7 @@ def truths(run, camera: RgbdCamera, names: list[str], colours: dict[str, str]) -
 
     seen = pixels()
     result = []
-    bodies = {name: model.body(run.context.world.objects[name].body).id for name in run.context.world.objects}
+    bodies = {name: model.body(body).id for name, body in run.sim.object_bodies.items()}
     for name in names:
         body = bodies[name]
         heights = {other: float(data.qpos[model.jnt_qposadr[model.body_jntadr[b]] + 2]) for other, b in bodies.items()}

@@ -140,7 +140,7 @@ class Injector:
 
 def _object_geoms(run: MissionRun, name: str) -> list[int]:
     model = run.sim.model
-    body = model.body(run.context.world.objects[name].body).id
+    body = model.body(run.sim.object_bodies[name]).id
     return list(range(model.body_geomadr[body], model.body_geomadr[body] + model.body_geomnum[body]))
 
 
@@ -209,7 +209,7 @@ class TargetMoved(Injector):
         if not far_enough:
             return
         spot = far_enough[0]
-        body = self.run.context.world.objects[self.obj].body
+        body = self.run.sim.object_bodies[self.obj]
         move_free_body(self.run, body, np.array([spot[0], spot[1], position[2] + 0.002]))
         self.fire(f"the {self.obj} was moved {np.hypot(*(spot[:2] - position[:2])):.2f} m")
 

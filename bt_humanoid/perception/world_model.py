@@ -36,6 +36,7 @@ class TrackedObject:
     grip_offset: float = 0.0  # m the grip site sits above the centre, while held
     yaw_known: bool = True  # false while a mug's handle has not been seen (its yaw is a guess)
     votes: Counter = field(default_factory=Counter)  # (kind, colour) → sightings, when perception tracks it
+    identity: str | None = None  # which of the world's objects it is ("coke"), where its look tells them apart
 
     @property
     def bottom(self) -> float:

@@ -28,8 +28,8 @@ def place_object(run: RobotStack, name: str, x: float, y: float, yaw: float) -> 
     if surface is None:
         raise ValueError(f"({x:.2f}, {y:.2f}) is on no known surface")
     model, data = run.sim.model, run.sim.data
-    body = model.body(run.context.world.objects[name].body)
-    obj = next(o for o in told_objects(run.context.world, model) if o.name == name)
+    body = model.body(run.sim.object_bodies[name])
+    obj = next(o for o in told_objects(run.sim) if o.name == name)
     bottom_in_body = obj.position[2] - obj.size[2] / 2 - body.pos[2]  # for an upright body
     position = np.array([x, y, surface.height - bottom_in_body + DROP])
     quat = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])

@@ -11,25 +11,26 @@ from __future__ import annotations
 
 import math
 
-import mujoco
 import numpy as np
 
 from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.perception.world_model import TrackedObject, WorldModel
 from bt_humanoid.sim.geometry import object_extents, rotation_of
-from bt_humanoid.sim.world_config import WorldConfig
+from bt_humanoid.sim.simulation import Simulation
 
 
-def told_objects(world: WorldConfig, model: mujoco.MjModel) -> list[TrackedObject]:
-    """Every declared object where the model puts it."""
+def told_objects(sim: Simulation) -> list[TrackedObject]:
+    """Every object of the run (the world's and its scene's) where the model puts it."""
     told = []
-    for name, declared in world.objects.items():
-        body = model.body(declared.body)
+    model = sim.model
+    for name, body_name in sim.object_bodies.items():
+        declared = sim.world.objects[sim.object_kinds[name]]
+        body = model.body(body_name)
         w, _, _, z = body.quat
         low, high = object_extents(model, body.id)
         told.append(
             TrackedObject(
-                id=declared.body,
+                id=body_name,
                 name=name,
                 kind=declared.kind,
                 colour=declared.colour,
@@ -37,14 +38,15 @@ def told_objects(world: WorldConfig, model: mujoco.MjModel) -> list[TrackedObjec
                 yaw=2.0 * math.atan2(z, w),
                 size=high - low,
                 keep_upright=declared.upright,
+                identity=sim.object_kinds[name],
             )
         )
     return told
 
 
-def tell_object_poses(belief: WorldModel, world: WorldConfig, model: mujoco.MjModel) -> None:
-    """Put every declared object into ``belief`` where the model puts it."""
-    for tracked in told_objects(world, model):
+def tell_object_poses(belief: WorldModel, sim: Simulation) -> None:
+    """Put every object of the run into ``belief`` where the model puts it."""
+    for tracked in told_objects(sim):
         belief.update(tracked)
 
 
@@ -54,5 +56,5 @@ def told_planning_context(world: str = "apartment") -> PlanningContext:
 
     stack = RobotStack.load(world, "wheeled_humanoid")
     stack.close()  # no looking: told, not seen
-    tell_object_poses(stack.context.world_model, stack.world, stack.sim.model)
+    tell_object_poses(stack.context.world_model, stack.sim)
     return PlanningContext(stack.world, stack.context.world_model, np.zeros(3))
