@@ -117,11 +117,18 @@ class WorldConfig(StrictModel):
     walkers: dict[str, Walker] = Field(default_factory=dict)  # body name → how they walk
     containers: dict[str, Container] = Field(default_factory=dict)
     scene: str | None = Field(None, description="the scene (scenes/NAME.yaml) a run starts from unless told another")
+    detector: str | None = Field(
+        None, description="folder of the learned detector for this world's objects (weights, recipe); none: shape rules"
+    )
     folder: Path = Path()
 
     @property
     def model_path(self) -> Path:
         return self.folder / self.model
+
+    @property
+    def detector_path(self) -> Path | None:
+        return self.folder / self.detector if self.detector is not None else None
 
     def outside_map(self, x: float, y: float) -> str | None:
         """Why (x, y) is not a place on this world's map, or None when it is."""
