@@ -14,6 +14,8 @@ MISSIONS = sorted((project_root() / "missions").glob("*.yaml"))
 BEHAVIORS = sorted(BehaviorLibrary().behaviors)
 # a valid value for every required behaviour parameter used in this repo
 SAMPLE_ARGS = {"place": "table", "object": "red cube", "surface": "counter", "to": "counter", "x": 8.4, "y": 2.8}
+# behaviours that need a world other than the apartment (its bins): the world and the arguments they take there
+IN_OTHER_WORLDS = {"throw_away": ("kitchen", {"object": "coke", "into": "trash_can"})}
 
 
 def assert_fully_wrapped(root: Behaviour) -> int:
@@ -50,9 +52,9 @@ def test_every_mission_is_fully_wrapped(mission):
 
 @pytest.mark.parametrize("behavior", BEHAVIORS)
 def test_every_behaviour_is_fully_wrapped(behavior):
-    args = _default_args(BehaviorLibrary().behaviors[behavior])
-    args = {k: SAMPLE_ARGS[k] for k in args}
-    run = build_run({"mission": f"wrap {behavior}", "tree": {behavior: args}})
+    world, samples = IN_OTHER_WORLDS.get(behavior, ("apartment", SAMPLE_ARGS))
+    args = {k: samples[k] for k in _default_args(BehaviorLibrary().behaviors[behavior])}
+    run = build_run({"mission": f"wrap {behavior}", "world": world, "tree": {behavior: args}})
     assert assert_fully_wrapped(run.compiled.root) > 1
 
 

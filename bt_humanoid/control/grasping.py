@@ -1,10 +1,21 @@
-"""Grasps from an object's believed geometry: where the grip site goes and how the hand is turned.
+"""Grasps from an object's believed shape: where the grip site goes and how the hand is turned.
 
 Every grasp here is top-down with the fingers closing horizontally: it keeps
-bottles and mugs upright, and it works for boxes, cylinders, mugs and balls.
-The hand's yaw is chosen among the object's symmetric options (boxes every
-90°, mugs every 180° across the body away from the handle, cylinders and
-balls any) as the one nearest the hand's current yaw.
+upright things upright, and it suits every shape the robot meets. The shape
+is the belief's: the object's extents and yaw, and whether its kind is round
+(cans, bottles, balls, fruit: the pads close on the diameter at any yaw) or
+has a handle (mugs: across the body, at right angles to the handle). Any
+other kind is held as the box its extents describe (cubes, boxes, bags of
+chips, bars, sponges), across one pair of its faces.
+
+Of the hand yaws a shape allows, the one nearest the hand's natural yaw whose
+width fits the open gripper with slack to spare wins: a bag of chips 12 cm
+by 5 cm is taken across its 5 cm, whichever way it stands.
+
+The grip site goes as high as the palm allows (tall things stay steady),
+never so low that the pads touch the surface, and low enough that the pads
+reach down over the object's top: a flat thing (an energy bar 2.2 cm high)
+is held with the pads just above the surface, the grip site above its top.
 """
 
 from __future__ import annotations
@@ -21,16 +32,20 @@ PAD_HALF_HEIGHT = 0.03  # m: finger pads reach this far below and above the grip
 PALM_ABOVE_GRIP = 0.06  # m: the palm's underside sits this far above the grip site
 SURFACE_CLEARANCE = 0.006  # m: pads stay this far above the support surface
 TOP_CLEARANCE = 0.008  # m: palm stays this far above the object's top
+MIN_PAD_OVERLAP = 0.01  # m: the pads reach at least this far down the object's sides from its top
 PRE_GRASP_HEIGHT = 0.1  # m above the grasp: the hand comes down from here
 LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
-OPENING_MARGIN = 0.01  # m the open pads must clear the object by, in total
+# m the open pads must clear the object by, in total: the descent ends within 8 mm of its target and 0.1 rad of
+# its yaw, so a pad 1.5 cm from the object's side cannot land on its top
+OPENING_MARGIN = 0.03
 
 # hand yaw relative to the base heading that suits either arm best for top-down grasps: the fingers close
 # along the heading, the forearm points forward and the wrist pitches the hand down (see the "ready"
 # posture in robot.yaml), which leaves every wrist joint mid-range
 NATURAL_YAW = 0.0
 
-SYMMETRY = {"cube": math.pi / 2, "box": math.pi / 2, "mug": math.pi, "bottle": 0.0, "can": 0.0, "ball": 0.0}
+ROUND_KINDS = frozenset({"can", "bottle", "ball", "fruit"})  # round in plan: closed on at any yaw
+HANDLED_KINDS = frozenset({"mug"})  # a handle along the object's x: closed on across the body, at right angles to it
 
 
 @dataclass(frozen=True)
@@ -49,7 +64,7 @@ class Grasp:
 
 
 class GraspError(ValueError):
-    """The object cannot be grasped by this hand (too wide, unknown shape)."""
+    """The object cannot be grasped by this hand (too wide, too flat)."""
 
 
 def natural_hand_yaw(base_yaw: float) -> float:
@@ -57,27 +72,47 @@ def natural_hand_yaw(base_yaw: float) -> float:
     return float(wrap_angle(base_yaw + NATURAL_YAW))
 
 
+def hand_yaws(obj: TrackedObject, hand_yaw: float) -> list[tuple[float, float]]:
+    """The ways a top-down hand can close on ``obj``: (hand yaw, width between the pads), by its believed shape.
+
+    A round object is closed on its diameter at ``hand_yaw`` itself; a mug across its body either way; any other
+    shape across either pair of its box's side faces, from each side.
+    """
+    length, breadth = float(obj.size[0]), float(obj.size[1])
+    if obj.kind in ROUND_KINDS:
+        return [(float(wrap_angle(hand_yaw)), min(length, breadth))]
+    if obj.kind in HANDLED_KINDS:
+        across = obj.yaw + math.pi / 2  # the fingers close along the hand's x: at right angles to the handle
+        return [(float(wrap_angle(across + k * math.pi)), breadth) for k in range(2)]
+    return [(float(wrap_angle(obj.yaw + k * math.pi / 2)), length if k % 2 == 0 else breadth) for k in range(4)]
+
+
+def grip_height(obj: TrackedObject, support_height: float) -> float:
+    """Where the grip site goes (z): palm above the top, pads above the surface and down over the object's top."""
+    highest = obj.top + PAD_HALF_HEIGHT - MIN_PAD_OVERLAP  # the pads' lower edge reaches down the object's sides
+    lowest = support_height + PAD_HALF_HEIGHT + SURFACE_CLEARANCE  # the pads' lower edge clears the surface
+    if lowest > highest:
+        raise GraspError(
+            f"the {obj.name} is {obj.size[2] * 100:.1f} cm high: too flat for the pads "
+            f"to close on it {SURFACE_CLEARANCE * 100:.1f} cm above the surface"
+        )
+    under_the_palm = obj.top + TOP_CLEARANCE - PALM_ABOVE_GRIP  # as high as the palm allows: tall things stay steady
+    return float(min(max(under_the_palm, lowest), highest))
+
+
 def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_opening: float) -> Grasp:
     """A top-down grasp of ``obj`` standing on a surface at ``support_height``, hand yaw nearest ``hand_yaw``.
 
     ``max_opening`` is the gap between the pads of the open gripper (m).
     """
-    if obj.kind not in SYMMETRY:
-        raise GraspError(f"no grasp for objects of kind {obj.kind!r}; graspable kinds: {', '.join(SYMMETRY)}")
-    # mugs: close across the body, at right angles to the handle (which points along the mug's x)
-    base_yaw = obj.yaw + (math.pi / 2 if obj.kind == "mug" else 0.0)
-    period = SYMMETRY[obj.kind]
-    yaw = hand_yaw if period == 0.0 else base_yaw + period * round(wrap_angle(hand_yaw - base_yaw) / period)
-    # the object's extent along the closing direction (the hand's x axis)
-    turn = yaw - obj.yaw
-    if period == 0.0:  # round: the diameter whichever way the pads close
-        width = float(obj.size[0])
-    else:
-        width = float(abs(math.cos(turn)) * obj.size[0] + abs(math.sin(turn)) * obj.size[1])
-    if width > max_opening - OPENING_MARGIN:
-        raise GraspError(f"{obj.name} is {width * 100:.0f} cm wide; the gripper opens {max_opening * 100:.0f} cm")
-    # as high as the palm allows (keeps tall things steady), never so low that the pads touch the surface
-    height = max(obj.top + TOP_CLEARANCE - PALM_ABOVE_GRIP, support_height + PAD_HALF_HEIGHT + SURFACE_CLEARANCE)
-    height = min(height, obj.top - 0.01)
-    position = np.array([obj.position[0], obj.position[1], height])
-    return Grasp(position, float(wrap_angle(yaw)), width)
+    options = hand_yaws(obj, hand_yaw)
+    fitting = [(yaw, width) for yaw, width in options if width <= max_opening - OPENING_MARGIN]
+    if not fitting:
+        narrowest = min(width for _, width in options)
+        raise GraspError(
+            f"the {obj.name} is {narrowest * 100:.1f} cm across at its narrowest; the gripper opens "
+            f"{max_opening * 100:.0f} cm and needs {OPENING_MARGIN * 100:.0f} cm to spare"
+        )
+    yaw, width = min(fitting, key=lambda option: abs(wrap_angle(option[0] - hand_yaw)))
+    position = np.array([obj.position[0], obj.position[1], grip_height(obj, support_height)])
+    return Grasp(position, yaw, width)

@@ -14,6 +14,7 @@ from bt_humanoid.mission.schema import (
     DeliveredCondition,
     GripperCondition,
     InHandCondition,
+    InsideCondition,
     NearCondition,
     OnCondition,
     SuccessCondition,
@@ -37,6 +38,12 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
         holds = truth.rests_on(obj, surface)
         x, y, z = truth.object_position(obj)
         return ConditionResult(f"{obj} on {surface}", holds, f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})")
+    if isinstance(condition, InsideCondition):
+        obj, container = condition.inside
+        x, y, z = truth.object_centre(obj)
+        return ConditionResult(
+            f"{obj} in the {container}", truth.inside(obj, container), f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})"
+        )
     if isinstance(condition, AtCondition):
         target = condition.at
         place, tolerance, yaw_tolerance = (

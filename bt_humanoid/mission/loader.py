@@ -322,6 +322,8 @@ class MissionLoader:
             names: list[tuple[str, dict]] = []
             if kind == "on":
                 names = [(data["on"][0], objects), (data["on"][1], surfaces)]
+            elif kind == "inside":
+                names = [(data["inside"][0], objects), (data["inside"][1], world.containers)]
             elif kind == "at":
                 target = data["at"] if isinstance(data["at"], str) else data["at"]["place"]
                 names = [(target, places)]

@@ -65,6 +65,10 @@ class OnCondition(StrictModel):
     on: tuple[str, str] = Field(description="[object, surface]: the object rests on the surface")
 
 
+class InsideCondition(StrictModel):
+    inside: tuple[str, str] = Field(description="[object, container]: the object lies in an open bin, below its rim")
+
+
 class AtCondition(StrictModel):
     at: str | PlaceTolerance = Field(description="the robot stands at a named place")
 
@@ -97,6 +101,7 @@ class GripperCondition(StrictModel):
 
 SuccessCondition = (
     OnCondition
+    | InsideCondition
     | AtCondition
     | InHandCondition
     | UprightCondition
@@ -104,7 +109,7 @@ SuccessCondition = (
     | GripperCondition
     | DeliveredCondition
 )
-CONDITION_KINDS = ("on", "at", "in_hand", "upright", "near", "gripper", "delivered")
+CONDITION_KINDS = ("on", "inside", "at", "in_hand", "upright", "near", "gripper", "delivered")
 
 
 class MissionHeader(StrictModel):

@@ -83,6 +83,13 @@ class GroundTruth:
         top = self.data.geom_xpos[geom][2] + self.model.geom_size[geom][2]
         return bool(self.object_position(obj)[2] > top and self.object_speed(obj) < RESTING_SPEED)
 
+    def inside(self, obj: str, container: str) -> bool:
+        """The object's centre lies within the container's opening (in plan) and below the top of its walls."""
+        bin_ = self.sim.world.containers[container]
+        (x0, y0), (x1, y1) = bin_.opening
+        x, y, z = self.object_centre(obj)
+        return bool(x0 <= x <= x1 and y0 <= y <= y1 and z < bin_.height)
+
     def upright(self, obj: str) -> bool:
         z_axis = self.data.xmat[self._object_body(obj)].reshape(3, 3)[:, 2]
         return bool(math.degrees(math.acos(np.clip(z_axis[2], -1, 1))) < UPRIGHT_TOLERANCE_DEG)

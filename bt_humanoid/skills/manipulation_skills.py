@@ -45,9 +45,10 @@ BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its lin
 class _ManipulationSkill(PhasedSkill):
     """Shared helpers: reach limits, the carry pose."""
 
-    def _keepout(self, surface: SupportSurface) -> Limit:
+    def _keepout(self, region: np.ndarray) -> Limit:
+        """Keep the base's footprint off a rectangle of the floor ([[x0, y0], [x1, y1]]: furniture reached over)."""
         radius = self.context.robot_config.base.footprint_radius + KEEPOUT_MARGIN
-        return BaseKeepoutLimit(self.context.robot_config.frames["base"][1], surface.region, radius)
+        return BaseKeepoutLimit(self.context.robot_config.frames["base"][1], region, radius)
 
     def _hand_yaw(self, side: str) -> float:
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
@@ -276,7 +277,7 @@ class Grasp(_ManipulationSkill):
     def _pre_grasp(self) -> MotionHandle:
         robot = self.context.robot
         robot.grippers.command(self.params.side, "open")  # opens while the hand travels
-        limits = [self._keepout(self.surface), self._clearance(self.params.side, self.surface, 0.0)]
+        limits = [self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, 0.0)]
         return robot.whole_body.reach(
             self.params.side, self._pose(self.grasp.pre_grasp), gaze=self.target.position, limits=limits
         )
@@ -287,7 +288,7 @@ class Grasp(_ManipulationSkill):
             self._pose(self.grasp.position),
             speed=DESCEND_SPEED,
             gaze=self.target.position,
-            limits=[self._keepout(self.surface)],
+            limits=[self._keepout(self.surface.region)],
             tolerance=(0.008, 0.1),
         )
 
@@ -385,7 +386,7 @@ class Put(_ManipulationSkill):
         return np.clip(hand_xy, region[0] + 0.12, region[1] - 0.12)
 
     def _above(self) -> MotionHandle:
-        limits = [self._keepout(self.surface), self._clearance(self.params.side, self.surface, self.below_hand)]
+        limits = [self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, self.below_hand)]
         target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, APPROACH_CLEARANCE + 0.02]))
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
 
@@ -396,7 +397,7 @@ class Put(_ManipulationSkill):
             target,
             speed=DESCEND_SPEED / 2,
             gaze=self.release,
-            limits=[self._keepout(self.surface)],
+            limits=[self._keepout(self.surface.region)],
             stop_on_contact=True,
         )
 
@@ -421,6 +422,80 @@ class Put(_ManipulationSkill):
         """Back to the carry pose, the pads kept above the placed object while the hand is over the surface."""
         clearance = self._clearance(self.params.side, self.surface, float(self.held.size[2]) + PAD_HALF_HEIGHT)
         return self._carry(self.params.side, [clearance])
+
+
+# --------------------------------------------------------------------------- drop
+
+
+class DropParams(StrictModel):
+    into: str = Field(description="an open bin of the world to drop the held object into")
+    side: Side = Field("right", description="the hand holding the object")
+
+
+DROP_CLEARANCE = 0.05  # m between the bottom of what the hand holds and the top of the bin's walls, when let go
+WALL_MARGIN = 0.03  # m round a bin's opening: its walls, which the hand and base keep clear of
+OPEN_ENOUGH = 0.9  # of the gripper's full opening: pads this far apart hold nothing
+
+
+# a drop that failed (the opening out of reach from where the robot stands) is tried again once
+@skill(
+    "drop",
+    "drop the held object into an open bin: hold it over the opening, let go, check the hand is empty",
+    recovery={"replan": 1},
+)
+class Drop(_ManipulationSkill):
+    Params = DropParams
+
+    @classmethod
+    def check(cls, params: DropParams, context: CheckContext) -> list[tuple[str, str]]:
+        return check_name(params.into, context.world.containers, "into", "container")
+
+    def phases(self):
+        return [
+            ("plan", self._plan),
+            ("over the opening", self._over),
+            ("let go", self._let_go),
+            ("check the hand", self._check_empty),
+            ("carry", lambda: self._carry(self.params.side, [self.walls])),
+        ]
+
+    def _plan(self) -> None:
+        side = self.params.side
+        self.held = self.context.world_model.held(side)
+        if self.held is None:
+            raise PhaseFailure(f"the {side} hand holds nothing")
+        container = self.context.world.containers[self.params.into]  # the map's bins, like its surfaces
+        opening = np.array(container.opening, dtype=float)
+        self.opening = opening
+        self.footprint = opening + np.array([[-WALL_MARGIN, -WALL_MARGIN], [WALL_MARGIN, WALL_MARGIN]])
+        self.bin_height = container.height
+        # what hangs below the hand clears the walls on the way in, and is let go just above them
+        below_hand = self.held.grip_offset + float(self.held.size[2]) / 2
+        frame = self.context.robot.whole_body.hand_frame(side)
+        self.walls = ClearanceLimit(frame, container.height + below_hand + APPROACH_CLEARANCE / 2, self.footprint)
+        centre = opening.mean(axis=0)
+        self.release = np.array([*centre, container.height + below_hand + DROP_CLEARANCE])
+
+    def _over(self) -> MotionHandle:
+        hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
+        target = pin.SE3(hand.rotation.copy(), self.release)  # as held: nothing swings
+        limits = [self._keepout(self.footprint), self.walls]
+        return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
+
+    def _let_go(self) -> MotionHandle:
+        self.held.held_by = None
+        # believed in the bin (somewhere on its floor) until it is seen again
+        self.held.position = np.array([*self.opening.mean(axis=0), float(self.held.size[2]) / 2])
+        self.held.last_seen = self.context.clock()
+        return self.context.robot.grippers.command(self.params.side, "open")
+
+    def _check_empty(self) -> None:
+        side = self.params.side
+        gripper = self.context.robot_config.grippers[side]
+        full = len(gripper.joints) * gripper.open
+        width = self.context.robot.grippers.width(side)
+        if width < OPEN_ENOUGH * full or self.context.world_model.held(side) is not None:
+            raise PhaseFailure(f"the {side} hand opened only {width * 100:.1f} cm: something is still in it")
 
 
 # --------------------------------------------------------------------------- release, look_at, give

@@ -10,13 +10,19 @@ so an object moved during a run is not followed.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.perception.world_model import TrackedObject, WorldModel
 from bt_humanoid.sim.geometry import object_extents, rotation_of
+from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.simulation import Simulation
+from bt_humanoid.sim.world_config import WorldConfig
+
+if TYPE_CHECKING:
+    from bt_humanoid.engine.stack import RobotStack
 
 
 def told_objects(sim: Simulation) -> list[TrackedObject]:
@@ -58,3 +64,16 @@ def told_planning_context(world: str = "apartment") -> PlanningContext:
     stack.close()  # no looking: told, not seen
     tell_object_poses(stack.context.world_model, stack.sim)
     return PlanningContext(stack.world, stack.context.world_model, np.zeros(3))
+
+
+def told_stack(world: WorldConfig, robot: RobotConfig, seed: int = 0) -> RobotStack:
+    """A stack whose robot is told where every object is, its head camera off: control alone.
+
+    Nothing a detector sees or misses moves the told objects, skills that look first (find, grasp) recall
+    instead, and the navigator plans on the map's furniture alone: for scenes with nothing else on the floor.
+    """
+    from bt_humanoid.engine.stack import RobotStack
+
+    stack = RobotStack(world, robot.model_copy(update={"cameras": {}}), seed)
+    tell_object_poses(stack.context.world_model, stack.sim)
+    return stack
