@@ -59,6 +59,12 @@ class GripperController:
         # closing never "arrives" when something is in the way: skip the settle check, judge the width instead
         return self.joints.move({joint: value for joint in config.joints}, settle_check=(action == "open"))
 
+    def start_closed(self, side: str) -> None:
+        """Initial conditions, before the first step: the hand was closed on something when the run began (a
+        scene handed the robot an object), so its fingers' references start shut and press on it at once."""
+        config = self.grippers[side]
+        self.joints.position[self.joints.indices(config.joints)] = config.closed
+
     def width(self, side: str) -> float:
         """Distance between the finger pads, from the finger encoders."""
         config = self.grippers[side]

@@ -215,16 +215,18 @@ def _trunk(sim: Simulation) -> set[int]:
 
 
 def stack_for(spec: MissionSpec, seed: int | None = None, speak: Callable[[str], None] | None = None) -> RobotStack:
-    """A fresh stack of the robot and world ``spec`` was checked against, seeded by ``seed`` or the mission's."""
+    """A fresh stack of the robot and world ``spec`` was checked against, in its scene (the command line's, the
+    mission's or the world's), seeded by ``seed`` or the mission's."""
     known = spec.known
-    return RobotStack(known.world, known.robot_config, spec.header.seed if seed is None else seed, speak)
+    return RobotStack(known.world, known.robot_config, spec.header.seed if seed is None else seed, speak, spec.scene)
 
 
-def run_mission_file(path: Path, seed: int | None = None) -> RunResult:
-    """Load, compile and run a mission headless on a fresh stack; the convenience entry for scripts and tests."""
+def run_mission_file(path: Path, seed: int | None = None, scene: str | None = None) -> RunResult:
+    """Load, compile and run a mission headless on a fresh stack (in ``scene``, by name or path, over the
+    mission's); the convenience entry for scripts and tests."""
     from bt_humanoid.mission.loader import MissionLoader
 
-    spec = MissionLoader().load_file(path)
+    spec = MissionLoader(scene=scene).load_file(path)
     stack = stack_for(spec, seed)
     try:
         return MissionRun(stack, spec).execute()

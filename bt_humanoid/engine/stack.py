@@ -8,6 +8,7 @@ interface, the arm and joint controllers, the navigator, the perceiver and the W
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -19,17 +20,23 @@ from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import Perceiver
 from bt_humanoid.perception.safety_scanner import SafetyScanner
+from bt_humanoid.perception.world_model import TrackedObject
 from bt_humanoid.safety.separation import SpeedAndSeparation
 from bt_humanoid.sim.assembly import joint_ranges
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
+from bt_humanoid.sim.scene_config import SceneConfig, load_scene
+from bt_humanoid.sim.scene_objects import body_name
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.skills.context import SkillContext
 
 
 class RobotStack:
-    """Builds and holds one robot in one world; ``close()`` when done (the cameras' off-screen contexts)."""
+    """Builds and holds one robot in one world; ``close()`` when done (the cameras' off-screen contexts).
+
+    ``scene``: the objects, start and held object a run starts from (none: the world's own scene, if any).
+    """
 
     def __init__(
         self,
@@ -37,8 +44,9 @@ class RobotStack:
         robot: RobotConfig,
         seed: int = 0,
         speak: Callable[[str], None] | None = None,
+        scene: SceneConfig | None = None,
     ) -> None:
-        self.sim = Simulation(world, robot)
+        self.sim = Simulation(world, robot, scene)
         self.sim.reset(seed)
         self.robot = RobotController(self.sim)
         self.navigator = Navigator(self.sim, self.robot, np.array(world.bounds))
@@ -66,6 +74,8 @@ class RobotStack:
             self.robot.planners.append(self.perceiver)
             self.context.perceiver = self.perceiver
         self.separation = self._separation()
+        if self.sim.held is not None:
+            self._handed_over()
 
     @classmethod
     def load(
@@ -75,13 +85,21 @@ class RobotStack:
         seed: int = 0,
         robot_start: tuple[float, float, float] | None = None,
         speak: Callable[[str], None] | None = None,
+        scene: str | SceneConfig | None = None,
     ) -> RobotStack:
-        """A stack of the named world (worlds/) and robot (robots/); ``robot_start`` [x, y, yaw_deg] replaces
-        the world's start pose (test and benchmark set-up)."""
+        """A stack of the named world (worlds/) and robot (robots/); ``scene`` by name (the world's scenes/), path
+        or config (none: the world's own); ``robot_start`` [x, y, yaw_deg] replaces the start pose of the world
+        and its scene (test and benchmark set-up)."""
         world_config = load_world_config(world)
+        if isinstance(scene, str):
+            scene = load_scene(world_config, scene, named_at="--scene")
+        elif scene is None and world_config.scene is not None:
+            scene = load_scene(world_config, world_config.scene, named_at=f"{world_config.folder.name}/world.yaml")
         if robot_start is not None:
             world_config = world_config.model_copy(update={"robot_start": tuple(robot_start)})
-        return cls(world_config, load_robot_config(robot), seed, speak)
+            if scene is not None:
+                scene = scene.model_copy(update={"robot_start": tuple(robot_start)})
+        return cls(world_config, load_robot_config(robot), seed, speak, scene)
 
     @property
     def world(self) -> WorldConfig:
@@ -110,6 +128,36 @@ class RobotStack:
     def close(self) -> None:
         if self.perceiver is not None:
             self.perceiver.close()
+
+    def _handed_over(self) -> None:
+        """The scene put an object in the robot's hand before the first step: its fingers stay shut on it, and it
+        believes what it holds. Told, not seen: whoever handed it over said what it is, so its identity is known
+        (a camera's sighting of a red can could be any red can); where it is comes from the robot's own arm."""
+        held, hold = self.sim.held, self.sim.hold
+        assert held is not None and held.hand is not None and hold is not None
+        self.robot.grippers.start_closed(held.hand)
+        declared = self.world.objects[held.object]
+        model = declared.model
+        assert model is not None
+        hand = self.robot.whole_body.frame_pose(self.robot.whole_body.hand_frame(held.hand))
+        grip_offset = hold.grip_height - hold.centre_height  # the grip site above the object's centre
+        top = model.size[2] + (model.cap.height if model.cap is not None else 0.0)
+        yaw = math.atan2(hand.rotation[1, 0], hand.rotation[0, 0]) + hold.turn
+        self.context.world_model.update(
+            TrackedObject(
+                id=body_name(held.name),
+                name=held.name,
+                kind=declared.kind,
+                colour=declared.colour,
+                position=hand.translation - np.array([0.0, 0.0, grip_offset]),
+                yaw=math.atan2(math.sin(yaw), math.cos(yaw)),
+                size=np.array([model.size[0], model.size[1], top]),
+                keep_upright=declared.upright,
+                held_by=held.hand,
+                grip_offset=grip_offset,
+                identity=held.object,
+            )
+        )
 
     def _separation(self) -> SpeedAndSeparation | None:
         """Speed and separation monitoring from the base scanner, when the robot has one."""

@@ -31,7 +31,8 @@ from bt_humanoid.mission.spec import MissionSpec, NodeSpec
 from bt_humanoid.paths import behaviors_dir
 from bt_humanoid.sim.assembly import joint_ranges
 from bt_humanoid.sim.robot_config import load_robot_config
-from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.sim.scene_config import SceneConfig, load_scene
+from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.skills import REGISTRY
 from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.params import is_reference
@@ -71,8 +72,11 @@ class MissionLoader:
         library: BehaviorLibrary | None = None,
         check_world: bool = True,
         subtree_roots: Sequence[Path] | None = None,
+        scene: str | SceneConfig | None = None,
     ) -> None:
         self.library = library or BehaviorLibrary()
+        # the scene given on the command line (a name, or a path from the working directory), over the mission's
+        self.scene = scene
         # False when checking a behaviour on its own: its arguments are placeholders then
         self.check_world = check_world
         # None: a subtree file is any file, relative to the one calling it (a person's own mission files).
@@ -111,10 +115,24 @@ class MissionLoader:
         robot = _config_at(load_robot_config, header.robot, source, "robot")
         world = _config_at(load_world_config, header.world, source, "world")
         self.checks = CheckContext(robot, world, joint_ranges(robot))
-        self._check_success(header, source)
+        scene = self._scene(header, world, source)
+        self._check_success(header, source, scene)
         alternatives = self._skill_recovery(header, source)
         tree = self._node(data["tree"], source, ("tree",), "tree", stack=())
-        return MissionSpec(header, tree, self.checks, source.file, alternatives)
+        return MissionSpec(header, tree, self.checks, source.file, alternatives, scene)
+
+    def _scene(self, header: MissionHeader, world: WorldConfig, source: YamlSource) -> SceneConfig | None:
+        """The scene the mission starts from: the command line's, else the mission's, else the world's own."""
+        if isinstance(self.scene, SceneConfig):
+            return self.scene
+        if self.scene is not None:
+            return load_scene(world, self.scene, named_at="--scene")
+        if header.scene is not None:
+            base = None if source.file.name.startswith("<") else source.file.parent
+            return load_scene(world, header.scene, base, named_at=source.where(("scene",)))
+        if world.scene is not None and self.check_world:
+            return load_scene(world, world.scene, named_at=f"worlds/{world.folder.name}/world.yaml")
+        return None
 
     # --- nodes ----------------------------------------------------------------------
 
@@ -312,9 +330,13 @@ class MissionLoader:
             except ValidationError as error:
                 raise source.invalid(error, ("success", i), prefix="success: ") from None
 
-    def _check_success(self, header: MissionHeader, source: YamlSource) -> None:
+    def _check_success(self, header: MissionHeader, source: YamlSource, scene: SceneConfig | None) -> None:
+        """Success conditions name what the run will have: places, surfaces, and objects of the world or its
+        scene ("coke 2", a scene's second coke: judged in ground truth, so it must be there)."""
         world = self.checks.world
-        surfaces, objects, places = world.surfaces, world.objects, world.places
+        surfaces, places = world.surfaces, world.places
+        objects = [name for name, o in world.objects.items() if o.body is not None]  # the world's fixed bodies
+        objects += [name for name, _ in scene.instances()] if scene is not None else []
         for i, condition in enumerate(header.success):
             data = condition.model_dump()
             kind = next(k for k in CONDITION_KINDS if k in data)
@@ -332,8 +354,16 @@ class MissionLoader:
             elif kind == "near":
                 names = [(data["near"]["object"], objects)]
             for name, valid in names:
-                if name not in valid:
-                    raise UserError(f"success: unknown name '{name}'", where=where, hint=did_you_mean(name, valid))
+                if name in valid:
+                    continue
+                if valid is objects and world.object_of(name) is not None:
+                    in_scene = f"scene '{scene.name}'" if scene is not None else f"world '{world.name}' (no scene)"
+                    raise UserError(
+                        f"success: no '{name}' in {in_scene}: a condition is judged on the objects the run has",
+                        where=where,
+                        hint=did_you_mean(name, valid) if valid else "the scene places no objects",
+                    )
+                raise UserError(f"success: unknown name '{name}'", where=where, hint=did_you_mean(name, valid))
 
     def _skill_recovery(self, header: MissionHeader, source: YamlSource) -> dict[str, NodeSpec]:
         """Check the per-skill recovery names; load their alternatives (one spec, compiled at each use)."""

@@ -119,6 +119,12 @@ class MissionHeader(StrictModel):
     description: str = ""
     world: str = Field("apartment", description="a folder of worlds/")
     robot: str = Field("wheeled_humanoid", description="a folder of robots/")
+    scene: str | None = Field(
+        None,
+        description="where the world's objects stand, where the robot starts and what it holds: a scene of the "
+        "world (worlds/WORLD/scenes/NAME.yaml) by name, or a scene file relative to this one; none: the world's "
+        "own (bt-run --scene overrides it)",
+    )
     seed: int = Field(0, description="default random seed")
     safety: SafetySection = SafetySection()
     recovery: RecoverySection = RecoverySection()

@@ -9,6 +9,7 @@ from typing import Any, Literal
 from pydantic import BaseModel
 
 from bt_humanoid.mission.schema import MissionHeader, RecoverySettings
+from bt_humanoid.sim.scene_config import SceneConfig
 from bt_humanoid.skills.context import CheckContext
 
 Category = Literal["composite", "decorator", "skill", "behavior"]
@@ -51,3 +52,6 @@ class MissionSpec:
     file: Path | None = None
     #: per-skill alternatives from the mission's recovery section, compiled afresh wherever the skill is used
     skill_alternatives: dict[str, NodeSpec] = field(default_factory=dict)
+    #: the scene a fresh robot for it starts from (the command line's, the mission's, or the world's own; None:
+    #: the world has none); missions run one after another on a robot start from wherever the last one left it
+    scene: SceneConfig | None = None

@@ -13,12 +13,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, PrivateAttr
 
 from bt_humanoid.errors import UserError, did_you_mean
-from bt_humanoid.sim.world_config import Pose2D, WorldConfig
+from bt_humanoid.sim.world_config import Pose2D, WorldConfig, instance_name
 from bt_humanoid.strict_model import StrictModel
-from bt_humanoid.yaml_source import YamlSource, read_model
+from bt_humanoid.yaml_source import YamlSource, display_path, read_model
 
 
 class Placement(StrictModel):
@@ -42,29 +42,64 @@ class SceneConfig(StrictModel):
     holding: Holding | None = Field(None, description="an object in the robot's hand at the start, held by friction")
     seed: int = Field(0, ge=0, description="draws the free spots and yaws the placements leave out")
     name: str = ""
+    _source: YamlSource | None = PrivateAttr(None)  # the file it was read from: errors found later name its lines
+
+    def where(self, *path: str | int) -> str | None:
+        """file:line of a key of the scene file (``where("objects", 2)``); None for a scene made in code."""
+        return self._source.where(path) if self._source is not None else None
+
+    def instances(self) -> list[tuple[str, str]]:
+        """Every object of the scene as (its name in a run, the world object it is one of): the one in hand
+        first, then the placements in order, numbered per object: "coke", "coke 2", "coke 3"."""
+        counts: dict[str, int] = {}
+        named = []
+        held = [self.holding.object] if self.holding is not None else []
+        for obj in [*held, *(p.object for p in self.objects)]:
+            counts[obj] = counts.get(obj, 0) + 1
+            named.append((instance_name(obj, counts[obj]), obj))
+        return named
 
 
-def scene_path(world: WorldConfig, scene: str) -> Path:
-    """A scene given by name (``scenes/NAME.yaml`` of the world) or by path."""
+def scene_names(world: WorldConfig) -> list[str]:
+    """The scenes of ``world`` by name (its scenes/ folder)."""
+    return sorted(p.stem for p in (world.folder / "scenes").glob("*.yaml"))
+
+
+def scene_path(world: WorldConfig, scene: str, base: Path | None = None) -> Path:
+    """A scene given by name (``scenes/NAME.yaml`` of the world) or by path (a .yaml file, relative to ``base``
+    when given: the folder of the mission that names it)."""
     given = Path(scene)
     if given.suffix in (".yaml", ".yml"):
-        if not given.is_file():
-            raise UserError(f"no scene file {scene}")
-        return given
+        path = given if base is None or given.is_absolute() else base / given
+        if not path.is_file():
+            raise UserError(f"scene file not found: {display_path(path)}")
+        return path
     named = world.folder / "scenes" / f"{scene}.yaml"
     if not named.is_file():
-        valid = sorted(p.stem for p in (world.folder / "scenes").glob("*.yaml"))
-        hint = did_you_mean(scene, valid) if valid else f"world '{world.name}' has no scenes/ folder"
+        valid = scene_names(world)
+        hint = (
+            did_you_mean(scene, valid) + "; or a scene file (.yaml)"
+            if valid
+            else f"world '{world.name}' has no scenes: its objects are fixed bodies of its model"
+        )
         raise UserError(f"unknown scene '{scene}' of world '{world.name}'", hint=hint)
     return named
 
 
-def load_scene(world: WorldConfig, scene: str) -> SceneConfig:
-    """Read a scene and check every name in it against ``world``."""
-    path = scene_path(world, scene)
+def load_scene(world: WorldConfig, scene: str, base: Path | None = None, named_at: str | None = None) -> SceneConfig:
+    """Read a scene (by name or path, see ``scene_path``) and check it against ``world``: every name in it, and
+    that its objects fit where it puts them. ``named_at``: where the scene was named (``mission.yaml:3``,
+    ``--scene``), for an unknown scene."""
+    try:
+        path = scene_path(world, scene, base)
+    except UserError as error:
+        raise UserError(error.message, where=named_at, hint=error.hint) from None
     config, source = read_model(path, SceneConfig, "a scene: a mapping with objects:, robot_start:, holding:")
+    config._source = source
     check_scene(config, world, source)
-    return config.model_copy(update={"name": config.name or path.stem})
+    named = config.model_copy(update={"name": config.name or path.stem})
+    named._source = source
+    return named
 
 
 def check_scene(scene: SceneConfig, world: WorldConfig, source: YamlSource | None = None) -> None:
@@ -73,7 +108,15 @@ def check_scene(scene: SceneConfig, world: WorldConfig, source: YamlSource | Non
     def where(*path: str | int) -> str | None:
         return source.where(path) if source is not None else None
 
-    placeable = [name for name, o in world.objects.items() if o.model is not None]
+    placeable = world.placeable
+    if not placeable and (scene.objects or scene.holding is not None):
+        first = ("objects", 0, "object") if scene.objects else ("holding", "object")
+        raise UserError(
+            f"world '{world.name}' has no objects a scene can place: its objects are fixed bodies of its model",
+            where=where(*first),
+            hint="scenes place the objects world.yaml gives by a model: (worlds/kitchen); "
+            "here, leave out objects: and holding:",
+        )
     for index, placement in enumerate(scene.objects):
         if placement.object not in placeable:
             raise UserError(
@@ -103,6 +146,17 @@ def check_scene(scene: SceneConfig, world: WorldConfig, source: YamlSource | Non
         outside = world.outside_map(*scene.robot_start[:2])
         if outside:
             raise UserError(f"robot_start: {outside}", where=where("robot_start"))
+    _check_placements(scene, world, source)
+
+
+def _check_placements(scene: SceneConfig, world: WorldConfig, source: YamlSource | None) -> None:
+    """The objects fit where the scene puts them: on their surface, apart, with a free spot for each left out."""
+    from bt_humanoid.sim.scene_objects import SceneError, place_scene, surface_tops
+
+    try:
+        place_scene(world, scene, surface_tops(world))
+    except SceneError as error:
+        raise UserError(error.message, where=source.where(error.path) if source is not None else None) from None
 
 
 def start_pose(scene: SceneConfig | None, world: WorldConfig) -> Pose2D:

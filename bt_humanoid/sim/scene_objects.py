@@ -34,6 +34,15 @@ class PlacedObject:
     body: str  # MJCF body name ("coke_2")
     position: np.ndarray  # centre of its main geom (world, m)
     yaw: float  # rad
+    hand: str | None = None  # "left" or "right": in the robot's hand at the start (put there when it resets)
+
+
+class SceneError(ValueError):
+    """A scene's objects do not fit where it puts them; ``path`` is the scene file's key concerned."""
+
+    def __init__(self, message: str, path: tuple[str | int, ...]) -> None:
+        super().__init__(message)
+        self.message, self.path = message, path
 
 
 def body_name(name: str) -> str:
@@ -50,43 +59,83 @@ def footprint_radius(model: ObjectModel) -> float:
 def place_scene(
     world: WorldConfig, scene: SceneConfig, surface_tops: dict[str, tuple[np.ndarray, float]]
 ) -> list[PlacedObject]:
-    """Where each of the scene's objects stands. ``surface_tops``: surface → ([[x0, y0], [x1, y1]], top z)."""
+    """Where each of the scene's objects stands. ``surface_tops``: surface → ([[x0, y0], [x1, y1]], top z).
+
+    The object in hand comes first (named first, see ``SceneConfig.instances``); it is built above the floor and
+    put in the hand when the simulation resets. A SceneError says which placement does not fit: a given spot
+    off its surface or on another object, or no free spot left for one without.
+    """
     rng = np.random.default_rng(scene.seed)
-    counts: dict[str, int] = {}
+    names = scene.instances()
     placed: list[PlacedObject] = []
-    for placement in scene.objects:
-        model = world.objects[placement.object].model
+    if scene.holding is not None:
+        name, obj = names.pop(0)
+        placed.append(PlacedObject(name, obj, body_name(name), np.array([0.0, 0.0, 1.0]), 0.0, scene.holding.hand))
+    standing: list[tuple[np.ndarray, float, int]] = []  # (x, y), footprint radius, placement index
+    for index, (placement, (name, obj)) in enumerate(zip(scene.objects, names, strict=True)):
+        model = world.objects[obj].model
         assert model is not None  # checked when the scene was loaded
         region, top = surface_tops[placement.on]
         radius = footprint_radius(model)
         if placement.at is not None:
             xy = (region[0] + region[1]) / 2 + np.array(placement.at)
+            _check_spot(xy, radius, region, standing, placement.on, index)
         else:
-            xy = _free_spot(region, radius, [(p.position[:2], _radius(world, p)) for p in placed], rng)
+            xy = _free_spot(region, radius, [(xy, r) for xy, r, _ in standing], rng)
+            if xy is None:
+                raise SceneError(
+                    f"objects[{index}]: no free spot left on the {placement.on} for the {obj} "
+                    f"({len([i for _, _, i in standing if scene.objects[i].on == placement.on])} objects on it "
+                    "already): too many objects for it; give spots (at:) or use another surface",
+                    ("objects", index),
+                )
         yaw = math.radians(placement.yaw) if placement.yaw is not None else float(rng.uniform(-math.pi, math.pi))
-        counts[placement.object] = counts.get(placement.object, 0) + 1
-        number = counts[placement.object]
-        name = placement.object if number == 1 else f"{placement.object} {number}"
         position = np.array([xy[0], xy[1], top + model.size[2] / 2 + DROP])
-        placed.append(PlacedObject(name, placement.object, body_name(name), position, yaw))
+        placed.append(PlacedObject(name, obj, body_name(name), position, yaw))
+        standing.append((xy, radius, index))
     return placed
 
 
-def _radius(world: WorldConfig, placed: PlacedObject) -> float:
-    model = world.objects[placed.object].model
-    assert model is not None
-    return footprint_radius(model)
+def _check_spot(
+    xy: np.ndarray,
+    radius: float,
+    region: np.ndarray,
+    standing: list[tuple[np.ndarray, float, int]],
+    surface: str,
+    index: int,
+) -> None:
+    """A given spot keeps the object's footprint on its surface and off the objects placed before it."""
+    centre, half = (region[0] + region[1]) / 2, (region[1] - region[0]) / 2
+    room = half - radius
+    offset = xy - centre
+    if np.any(np.abs(offset) > room + 1e-9):
+        raise SceneError(
+            f"objects[{index}]: at [{offset[0]:g}, {offset[1]:g}] is off the {surface} for this object "
+            f"(its footprint reaches {radius * 100:.1f} cm out): dx within ±{room[0]:.3f}, dy within ±{room[1]:.3f}",
+            ("objects", index, "at"),
+        )
+    for other, other_radius, other_index in standing:
+        gap = float(np.hypot(*(xy - other))) - radius - other_radius
+        if gap < 0.0:
+            raise SceneError(
+                f"objects[{index}]: at [{offset[0]:g}, {offset[1]:g}] overlaps objects[{other_index}] "
+                f"(by {-gap * 100:.1f} cm, footprints as circles)",
+                ("objects", index, "at"),
+            )
 
 
 def _free_spot(
     region: np.ndarray, radius: float, others: list[tuple[np.ndarray, float]], rng: np.random.Generator
-) -> np.ndarray:
+) -> np.ndarray | None:
+    """A random spot inside the surface's edge and clear of ``others``; None when none is found."""
     low, high = region[0] + EDGE_MARGIN + radius, region[1] - EDGE_MARGIN - radius
+    if np.any(low > high):
+        return None
     for _ in range(ATTEMPTS):
         spot = rng.uniform(low, high)
         if all(np.hypot(*(spot - xy)) >= radius + r + GAP for xy, r in others):
             return spot
-    raise ValueError("no free spot left on the surface: too many objects for it")
+    return None
 
 
 def add_objects(spec: mujoco.MjSpec, world: WorldConfig, objects: list[PlacedObject]) -> None:

@@ -15,10 +15,12 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import mujoco
 import numpy as np
 
+from bt_humanoid.errors import UserError
 from bt_humanoid.sim.assembly import world_spec
+from bt_humanoid.sim.holding import CARRY_POSTURE, SQUEEZE, Hold, hold_for
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig, load_scene, start_pose
-from bt_humanoid.sim.scene_objects import place_scene, surface_tops
+from bt_humanoid.sim.scene_objects import PlacedObject, SceneError, place_scene, surface_tops
 from bt_humanoid.sim.walkers import WalkerDriver
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 
@@ -32,7 +34,15 @@ class Simulation:
         if scene is None and world.scene is not None:
             scene = load_scene(world, world.scene)
         self.scene = scene
-        placed = place_scene(world, scene, surface_tops(world)) if scene is not None else []
+        try:
+            placed = place_scene(world, scene, surface_tops(world)) if scene is not None else []
+        except SceneError as error:  # a scene made in code (a random draw); files are checked when loaded
+            raise UserError(error.message, where=scene.where(*error.path) if scene is not None else None) from None
+        #: the object the robot holds at the start (a scene's holding:), and how its hand holds it
+        self.held: PlacedObject | None = next((p for p in placed if p.hand is not None), None)
+        self.hold: Hold | None = None
+        if self.held is not None:
+            self.hold = self._check_hold(self.held)
         #: every object of the run by its name ("coke 2") → its body; the world's fixed objects and the scene's
         self.object_bodies = {name: o.body for name, o in world.objects.items() if o.body is not None}
         self.object_bodies |= {p.name: p.body for p in placed}
@@ -72,12 +82,70 @@ class Simulation:
         self.set_initial_joint(base["yaw"], math.radians(yaw_deg))
         for joint, value in self.robot.postures.get("home", {}).items():
             self.set_initial_joint(joint, value)
+        if self.held is not None:
+            self._hand_over(self.held)
         for joint in self.robot.actuated_joints:
             actuator = self.actuator_for_joint(joint)
             self.data.ctrl[actuator] = self.data.qpos[self.model.joint(joint).qposadr[0]]
+        if self.held is not None:  # the hand closed on what it was handed: its fingers press on it
+            gripper = self.robot.grippers[self.held.hand]  # type: ignore[index]
+            for joint in gripper.joints:
+                self.data.ctrl[self.actuator_for_joint(joint)] = gripper.closed
         self.seed = seed  # the run's seed: whatever draws random numbers (route planning) starts from it
         self.rng = np.random.default_rng(seed)
         mujoco.mj_forward(self.model, self.data)
+
+    def _check_hold(self, held: PlacedObject) -> Hold:
+        """How the hand holds the scene's object; a UserError when this robot cannot hold it so."""
+        model = self.world.objects[held.object].model
+        assert model is not None and held.hand is not None  # checked when the scene was loaded
+        where = self.scene.where("holding") if self.scene is not None else None
+        if held.hand not in self.robot.grippers:
+            raise UserError(
+                f"holding: robot '{self.robot.name}' has no {held.hand} hand",
+                where=where,
+                hint=f"valid: {', '.join(self.robot.grippers)}",
+            )
+        if CARRY_POSTURE not in self.robot.postures:
+            raise UserError(
+                f"holding: robot '{self.robot.name}' has no '{CARRY_POSTURE}' posture to hold things in (robot.yaml)",
+                where=where,
+            )
+        hold = hold_for(model)
+        gripper = self.robot.grippers[held.hand]
+        opening = 2 * (gripper.open - gripper.closed)
+        if hold.width >= opening:
+            raise UserError(
+                f"holding: the {held.object} is {hold.width * 100:.1f} cm across; "
+                f"the {held.hand} gripper opens {opening * 100:.1f} cm",
+                where=where,
+            )
+        return hold
+
+    def _hand_over(self, held: PlacedObject) -> None:
+        """Initial conditions: the arm in its carrying posture, the object between the pads, the fingers on it.
+
+        Nothing holds it there but the fingers' squeeze and friction, from the first step on.
+        """
+        assert self.hold is not None and held.hand is not None
+        arm = set(self.robot.groups.get(f"{held.hand}_arm", []))
+        for joint, value in self.robot.postures[CARRY_POSTURE].items():
+            if joint in arm or joint in self.robot.groups.get("lift", []):
+                self.set_initial_joint(joint, value)
+        gripper = self.robot.grippers[held.hand]
+        for joint in gripper.joints:  # each finger's pad at the object's side, pressed in a little
+            self.set_initial_joint(joint, self.hold.width / 2 - SQUEEZE)
+        mujoco.mj_kinematics(self.model, self.data)
+        site = self.model.site(gripper.grip_site).id
+        hand = self.data.site_xmat[site].reshape(3, 3)  # pointing down: its z axis is up, the pads close along x
+        turn = self.hold.turn
+        turned = hand @ np.array([[math.cos(turn), -math.sin(turn), 0], [math.sin(turn), math.cos(turn), 0], [0, 0, 1]])
+        quat = np.zeros(4)
+        mujoco.mju_mat2Quat(quat, turned.flatten())
+        position = self.data.site_xpos[site] - self.hold.grip_height * hand[:, 2]
+        body = self.model.body(held.body).id
+        address = self.model.jnt_qposadr[self.model.body_jntadr[body]]
+        self.data.qpos[address : address + 7] = np.concatenate([position, quat])
 
     def set_initial_joint(self, joint: str, value: float) -> None:
         """Initial conditions only (reset and test set-up), never to move things."""

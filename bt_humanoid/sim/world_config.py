@@ -138,6 +138,20 @@ class WorldConfig(StrictModel):
         return f"({x}, {y}) is outside the map: x {x0:g} to {x1:g}, y {y0:g} to {y1:g}"
 
     @property
+    def placeable(self) -> list[str]:
+        """The objects scenes place (those given by a model), as many of each as a scene likes."""
+        return [name for name, o in self.objects.items() if o.model is not None]
+
+    def object_of(self, name: str) -> str | None:
+        """The world object ``name`` is one of: itself for a world object, "coke" for "coke 2" (a scene's second
+        coke, see ``instance_name``); None for a name that is neither."""
+        if name in self.objects:
+            return name
+        base, _, number = name.rpartition(" ")
+        placeable = base in self.objects and self.objects[base].model is not None
+        return base if placeable and number.isdigit() and not number.startswith("0") and int(number) >= 2 else None
+
+    @property
     def person_names(self) -> list[str]:
         """Every name a person answers to: their own and their aliases ("me", "user")."""
         return [n for name, person in self.people.items() for n in (name, *person.aliases)]
@@ -146,6 +160,11 @@ class WorldConfig(StrictModel):
         if name not in self.places:
             raise UserError(f"unknown place '{name}' in world '{self.name}'", hint=did_you_mean(name, self.places))
         return self.places[name]
+
+
+def instance_name(obj: str, number: int) -> str:
+    """What the ``number``-th of a world object in a scene is called: "coke", "coke 2", "coke 3"."""
+    return obj if number == 1 else f"{obj} {number}"
 
 
 def load_world_config(name: str) -> WorldConfig:
