@@ -74,6 +74,12 @@ def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> No
     parser.add_argument("--world", default="apartment", help="world of a command (default: apartment)")
     parser.add_argument("--robot", default="wheeled_humanoid", help="robot of a command (default: wheeled_humanoid)")
     parser.add_argument(
+        "--scene",
+        metavar="NAME|FILE",
+        help="the scene the world starts from: a name in worlds/WORLD/scenes/ or a scene file "
+        "(default: the mission's, else the world's own)",
+    )
+    parser.add_argument(
         "--answer", action="append", default=[], metavar="TEXT", help="answer to the planner's question (repeatable)"
     )
     parser.add_argument("--llm-url", help="OpenAI-compatible endpoint to plan with (or BT_LLM_BASE_URL)")
@@ -103,14 +109,14 @@ def run_main(argv: list[str] | None = None) -> int:
             args.command = _heard_command(args, console)
         if args.command is not None:
             # one robot from its first look to its last step: the plan comes from what this stack believes
-            stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=speech)
+            stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=speech, scene=args.scene)
             outcome = _plan_from_command(args, console, stack)
             if outcome.spec is None:
                 stack.close()
                 return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
             spec = outcome.spec
         else:
-            spec = MissionLoader().load_file(args.mission)
+            spec = MissionLoader(scene=args.scene).load_file(args.mission)
             stack = stack_for(spec, args.seed, speak=speech)
         run = MissionRun(stack, spec, tick_hz=args.tick_hz)
         recorder = None
@@ -265,7 +271,7 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
         from bt_humanoid.engine.stack import RobotStack
 
         planner = _planner(args)
-        stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=say)
+        stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=say, scene=args.scene)
         session = InteractiveSession(stack, lines, say, planner)
         if args.listen:
             relay = _listener_thread(args, lines, session, console)
@@ -370,7 +376,7 @@ def plan_main(argv: list[str] | None = None) -> int:
     try:
         from bt_humanoid.engine.stack import RobotStack
 
-        stack = RobotStack.load(args.world, args.robot)
+        stack = RobotStack.load(args.world, args.robot, scene=args.scene)
         outcome = _plan_from_command(args, console, stack)
     except UserError as error:
         return _fail_invalid(error)

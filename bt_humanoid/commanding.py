@@ -75,7 +75,7 @@ def _belief_problems(node: NodeSpec, context: PlanningContext, step: str | None 
     if node.category == "skill" and node.settings is not None:
         where = step or node.where
         for parameter, value in named_objects(node.settings, node.raw):
-            if value in context.world.objects:
+            if context.world.object_of(value) is not None:  # a world object, or one of a scene's ("coke 2")
                 continue
             try:
                 resolve(value, context.belief, context.robot_pose)

@@ -127,7 +127,7 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
     run = build_run(mission, robot_start=trial.start)
     parking = iter(PARKING)
     surfaces = map_world_model(run.context.world, run.sim.model)
-    for other in list(run.context.world.objects):
+    for other in list(run.sim.object_bodies):
         surface = surfaces.surface_under(run.truth.object_centre(other))
         if other != name and surface is not None and surface.name == SURFACE:
             place_object(run, other, *next(parking), 0.0)
@@ -146,7 +146,7 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
     truth = run.truth
     x, y, _ = truth.object_position(name)
     error = float(np.hypot(x - trial.place[0], y - trial.place[1]))
-    upright = truth.upright(name) or not run.context.world.objects[name].upright
+    upright = truth.upright(name) or not run.context.world.objects[run.sim.object_kinds[name]].upright
     placed = (
         result.tree_status == "SUCCESS"
         and truth.in_hand(name) is None

@@ -73,7 +73,7 @@ def build_scene(rng: np.random.Generator):
     """A robot stack set up as one random scene, and the colour each object on the table was painted."""
     probe = _probe()
     table = probe.context.world_model.surface(SURFACE)
-    names = list(probe.world.objects)
+    names = list(probe.sim.object_bodies)  # the objects of the run: the world's, or its scene's
     chosen = list(rng.choice(names, size=int(rng.integers(1, 5)), replace=False))
     (x0, y0), (x1, y1) = table.region
     side = int(rng.integers(3))  # west, south, east: the chair blocks the north
@@ -164,11 +164,12 @@ def truths(run, camera: RgbdCamera, names: list[str], colours: dict[str, str]) -
             data.qpos[model.jnt_qposadr[model.body_jntadr[b]] + 2] = heights[other]
         mujoco.mj_forward(model, data)
         centre = run.truth.object_centre(name)
+        declared = run.context.world.objects[run.sim.object_kinds[name]]
         result.append(
             Truth(
                 name,
-                run.context.world.objects[name].kind,
-                colours.get(name, run.context.world.objects[name].colour),
+                declared.kind,
+                colours.get(name, declared.colour),
                 centre,
                 min(seen.get(body, 0) / alone, 1.0) if alone else 0.0,
                 _in_image(camera, centre),
@@ -212,7 +213,7 @@ def main(argv: list[str] | None = None) -> int:
         t2 = time.perf_counter()
         render_ms.append((t1 - t0) * 1000)
         detect_ms.append((t2 - t1) * 1000)
-        objects = truths(run, camera, list(run.context.world.objects), colours)
+        objects = truths(run, camera, list(run.sim.object_bodies), colours)
         camera.close()
         run.close()
         eye = frame.position

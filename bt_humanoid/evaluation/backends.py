@@ -26,7 +26,9 @@ def _pin_worker(cores: list[int], counter) -> None:
         os.sched_setaffinity(0, {cores[slot % len(cores)]})
 
 
-def run_local(suite_file: str, indices: list[int], seed: int, workers: int) -> Iterator[dict[str, Any]]:
+def run_local(
+    suite_file: str, indices: list[int], seed: int, workers: int, scene: str | None = None
+) -> Iterator[dict[str, Any]]:
     """Episodes in ``workers`` processes (spawned: each has its own MuJoCo and renderers), or in this one."""
     cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
     if workers == 1:
@@ -34,7 +36,7 @@ def run_local(suite_file: str, indices: list[int], seed: int, workers: int) -> I
             if cores:
                 os.sched_setaffinity(0, {cores[0]})
             for index in indices:
-                yield run_episode(suite_file, index, seed)
+                yield run_episode(suite_file, index, seed, scene=scene)
         finally:
             if cores:
                 os.sched_setaffinity(0, set(cores))
@@ -42,12 +44,14 @@ def run_local(suite_file: str, indices: list[int], seed: int, workers: int) -> I
     context = multiprocessing.get_context("spawn")
     counter = context.Value("i", 0)
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_pin_worker, initargs=(cores, counter)) as pool:
-        futures = [pool.submit(run_episode, suite_file, index, seed) for index in indices]
+        futures = [pool.submit(run_episode, suite_file, index, seed, None, scene) for index in indices]
         for future in as_completed(futures):
             yield future.result()
 
 
-def run_ray(suite_file: str, indices: list[int], seed: int, address: str | None) -> Iterator[dict[str, Any]]:
+def run_ray(
+    suite_file: str, indices: list[int], seed: int, address: str | None, scene: str | None = None
+) -> Iterator[dict[str, Any]]:
     """Episodes as Ray tasks, one CPU each, on the cluster at ``address`` (or a local Ray instance)."""
     try:
         import ray
@@ -58,7 +62,7 @@ def run_ray(suite_file: str, indices: list[int], seed: int, address: str | None)
     if not ray.is_initialized():
         ray.init(address=address, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
     remote = ray.remote(num_cpus=1)(run_episode)
-    pending = [remote.remote(suite_file, index, seed) for index in indices]
+    pending = [remote.remote(suite_file, index, seed, None, scene) for index in indices]
     while pending:
         finished, pending = ray.wait(pending, num_returns=1)
         yield ray.get(finished[0])

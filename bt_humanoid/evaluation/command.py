@@ -29,6 +29,11 @@ def _parser() -> _Parser:
     )
     parser.add_argument("--episodes", type=int, help="how many episodes (default: the suite's)")
     parser.add_argument("--seed", type=int, help="draws every scene (default: the suite's)")
+    parser.add_argument(
+        "--scene",
+        metavar="NAME|FILE",
+        help="the scene episodes start from: a name in the world's scenes/ or a scene file (default: the suite's)",
+    )
     parser.add_argument("--workers", type=int, default=1, help="worker processes, one core each (default 1)")
     parser.add_argument("--backend", choices=["local", "ray"], default="local", help="where episodes run")
     parser.add_argument("--address", help="Ray cluster address for --backend ray (default: start a local Ray)")
@@ -56,7 +61,9 @@ def eval_main(argv: list[str] | None = None) -> int:
         if args.seed is not None and args.seed < 0:
             raise UserError(f"--seed {args.seed}: give 0 or more")
         file = _suite_file(args.suite)
-        suite, _ = load_suite(file)
+        suite, _ = load_suite(file, args.scene)
+        if args.scene is not None:
+            args.scene = suite.scene  # a file's path made absolute: the workers may start elsewhere
         episodes = args.episodes or suite.episodes
         seed = suite.seed if args.seed is None else args.seed
         console.print(
@@ -117,9 +124,9 @@ def _run(file: str, indices: list[int], seed: int, args, console: Console) -> tu
     from bt_humanoid.evaluation.backends import run_local, run_ray
 
     stream = (
-        run_ray(file, indices, seed, args.address)
+        run_ray(file, indices, seed, args.address, args.scene)
         if args.backend == "ray"
-        else run_local(file, indices, seed, args.workers)
+        else run_local(file, indices, seed, args.workers, args.scene)
     )
     records: list[dict[str, Any]] = []
     started = time.perf_counter()

@@ -27,15 +27,16 @@ from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.engine.verdict import check_condition
 from bt_humanoid.evaluation import faults as fault_kinds
 from bt_humanoid.evaluation.scenes import nudge, reachable_spot
-from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite
+from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite, suite_scene
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
+from bt_humanoid.sim.scene_config import Placement, SceneConfig
 from bt_humanoid.testing.scene import place_object
 
 
 @cache
-def _suite(path: str) -> Suite:
-    return load_suite(Path(path))[0]
+def _suite(path: str, scene: str | None = None) -> Suite:
+    return load_suite(Path(path), scene)[0]
 
 
 @cache
@@ -72,14 +73,19 @@ class Draw:
 
 
 def run_episode(
-    suite_file: str, index: int, seed: int | None = None, events: list[dict[str, Any]] | None = None
+    suite_file: str,
+    index: int,
+    seed: int | None = None,
+    events: list[dict[str, Any]] | None = None,
+    scene: str | None = None,
 ) -> dict[str, Any]:
-    """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``); figures and verdict as a dict.
+    """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``; its scene, or ``scene``: a
+    name, or a file's absolute path); figures and verdict as a dict.
 
     ``events``, when given, receives the run's event log (tests look at how a fault was recovered from).
     """
     started = time.perf_counter()
-    suite = _suite(suite_file)
+    suite = _suite(suite_file, scene)
     if seed is not None:
         suite = suite.model_copy(update={"seed": seed})
     draw = Draw(suite, index)
@@ -114,7 +120,11 @@ def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> RobotStack:
     rng, world = draw.rng, probe.world
     start = free_start(probe.navigator.grid, world, rng) if suite.randomize.start == "random" else None
     seed = int(np.random.SeedSequence([suite.seed, draw.index]).generate_state(1)[0])
-    run = RobotStack.load(suite.world, suite.robot, seed, robot_start=start)
+    scene = suite_scene(suite, world)
+    if suite.randomize.scene is not None:
+        scene = _random_scene(suite, draw, probe, scene)
+        record["scene"] = [placement.object for placement in scene.objects]
+    run = RobotStack.load(suite.world, suite.robot, seed, robot_start=start, scene=scene)
     model = run.sim.model
     for name in suite.randomize.obstacles:  # the furniture rearranged, and the robot's floor plan redrawn
         body = model.body(name).id
@@ -131,16 +141,55 @@ def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> RobotStack:
     def spot_among(others: list[np.ndarray]) -> np.ndarray:
         return reachable_spot(surface, probe.navigator.grid, footprint, bounds, others, rng)
 
-    spot = spot_among([run.truth.object_position(o) for o in world.objects if o != draw.obj])
-    place_object(run, draw.obj, float(spot[0]), float(spot[1]), float(rng.uniform(-math.pi, math.pi)))
+    objects = list(run.sim.object_bodies)  # the run's: the world's fixed bodies, or its scene's
+    if suite.randomize.scene is None:  # a random scene already put it at a reachable spot on that surface
+        spot = spot_among([run.truth.object_position(o) for o in objects if o != draw.obj])
+        place_object(run, draw.obj, float(spot[0]), float(spot[1]), float(rng.uniform(-math.pi, math.pi)))
+    spot = run.truth.object_position(draw.obj)
     record["object_at"] = [draw.start_surface, round(float(spot[0]), 3), round(float(spot[1]), 3)]
-    others = [run.truth.object_position(o) for o in world.objects]  # the object included, where it now stands
+    others = [run.truth.object_position(o) for o in objects]  # the object included, where it now stands
     for _ in range(5):  # spots a fault may move it to
         try:
             draw.spare_spots.append(spot_among(others + draw.spare_spots))
         except ValueError:
             break
     return run
+
+
+def _random_scene(suite: Suite, draw: Draw, probe: RobotStack, base: SceneConfig | None) -> SceneConfig:
+    """The episode's own scene: the suite's start and held object, with objects drawn anew at spots the right
+    hand reaches (``reachable_spot``), the episode's object first (on its start surface, when the suite names
+    some). An object with no reachable spot left on its surface is left out."""
+    settings = suite.randomize.scene
+    assert settings is not None
+    rng, world = draw.rng, probe.world
+    belief = probe.context.world_model
+    footprint, bounds = probe.context.robot_config.base.footprint_radius, np.array(world.bounds)
+    fewest, most = settings.objects
+    count = int(rng.integers(fewest, most + 1))
+    among = settings.among or world.placeable
+    chosen = [draw.obj] if draw.obj else []
+    chosen += [str(name) for name in rng.choice(among, size=count - len(chosen))] if count > len(chosen) else []
+    placements: list[Placement] = []
+    taken: list[np.ndarray] = []
+    for index, name in enumerate(chosen):
+        first = index == 0 and draw.obj and draw.start_surface is not None
+        on = draw.start_surface if first else str(rng.choice(settings.surfaces))
+        surface = belief.surface(on)
+        try:
+            spot = reachable_spot(surface, probe.navigator.grid, footprint, bounds, taken, rng)
+        except ValueError:
+            if index == 0 and draw.obj:
+                raise
+            continue
+        taken.append(spot)
+        at = spot - (surface.region[0] + surface.region[1]) / 2
+        yaw = float(rng.uniform(-180.0, 180.0))
+        placements.append(Placement(object=name, on=on, at=(float(at[0]), float(at[1])), yaw=yaw))
+    start = base or SceneConfig()
+    return SceneConfig(
+        robot_start=start.robot_start, holding=start.holding, objects=placements, name=f"random {draw.index}"
+    )
 
 
 def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: RobotStack) -> dict[str, Any]:
@@ -227,9 +276,9 @@ def _verdict(
     """Success in ground truth, and the figures the suite aggregates."""
     header = MissionHeader.model_validate({"mission": "expect", "success": expect})
     conditions = list(header.success)
-    world = run.context.world
+    world, kinds = run.context.world, run.sim.object_kinds
     for condition in header.success:  # things people keep upright must arrive upright
-        if isinstance(condition, OnCondition) and world.objects[condition.on[0]].upright:
+        if isinstance(condition, OnCondition) and world.objects[kinds[condition.on[0]]].upright:
             conditions.append(UprightCondition(upright=condition.on[0]))
     checked = [check_condition(c, run.truth) for c in conditions]
     unmet = [f"{c.condition} ({c.detail})" for c in checked if not c.holds]

@@ -2,9 +2,10 @@
 
 A suite says which tasks to run (typed commands with ``{object}`` and
 ``{surface}`` slots, or mission files), over which objects and surfaces,
-how scenes are randomized (object spots, the robot's start, obstacle
-nudges), how many episodes from which seed, and which share of episodes get
-an injected fault. Episodes are drawn from the seed alone, so the same suite
+the scene episodes start from (``scene:``, in a world with scenes), how
+scenes are randomized (object spots, a random scene of the world's objects,
+the robot's start, obstacle nudges), how many episodes from which seed, and
+which share of episodes get an injected fault. Episodes are drawn from the seed alone, so the same suite
 and seed give the same episodes on any machine and with any worker count.
 """
 
@@ -18,6 +19,7 @@ from pydantic import Field, model_validator
 from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.evaluation.faults import FAULT_MODELS, FaultConfig
 from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.sim.scene_config import Placement, SceneConfig, load_scene
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.strict_model import StrictModel, exactly_one
 from bt_humanoid.yaml_source import YamlSource, read_model
@@ -42,12 +44,35 @@ class Task(StrictModel):
         return self
 
 
+class SceneDraw(StrictModel):
+    """A random scene for each episode: some of the world's objects (those scenes place) on some surfaces."""
+
+    objects: tuple[int, int] = Field(
+        description="[fewest, most] objects in an episode's scene, the episode's {object} among them"
+    )
+    surfaces: list[str] = Field(min_length=1, description="surfaces they stand on, at random spots the hand reaches")
+    among: list[str] = Field(
+        default_factory=list,
+        description='objects to draw from, as many of each as drawn ("coke", "coke 2"); none: every one scenes place',
+    )
+
+    @model_validator(mode="after")
+    def _range(self) -> SceneDraw:
+        fewest, most = self.objects
+        if not 1 <= fewest <= most <= 40:
+            raise ValueError(f"objects: [{fewest}, {most}] is no range: give [fewest, most], 1 <= fewest <= most <= 40")
+        return self
+
+
 class Randomize(StrictModel):
     """How each episode's scene differs from the world file."""
 
     start: Literal["world", "random"] = Field("random", description="robot start: the world's, or a random free pose")
     object_on: list[str] = Field(
         default_factory=list, description="surfaces the episode's object starts on, at a random reachable spot"
+    )
+    scene: SceneDraw | None = Field(
+        None, description="draw each episode's objects anew (the suite's scene keeps its start and what is held)"
     )
     obstacles: list[str] = Field(default_factory=list, description="obstacle bodies nudged by up to obstacle_shift")
     obstacle_shift: float = Field(0.25, ge=0, le=1.0, description="m, largest nudge of an obstacle")
@@ -72,6 +97,11 @@ class Suite(StrictModel):
     description: str = ""
     world: str = Field("apartment", description="a folder of worlds/")
     robot: str = Field("wheeled_humanoid", description="a folder of robots/")
+    scene: str | None = Field(
+        None,
+        description="the scene episodes start from: a name in the world's scenes/, or a file relative to the suite; "
+        "none: the world's own",
+    )
     episodes: int = Field(20, ge=1, le=100_000, description="how many episodes")
     seed: int = Field(0, ge=0, description="draws every episode's scene, task and fault")
     objects: list[str] = Field(default_factory=list, description="objects for {object}, one drawn per episode")
@@ -82,13 +112,38 @@ class Suite(StrictModel):
     time_budget: float = Field(300.0, gt=0, le=86400, description="simulation seconds per episode")
 
 
-def load_suite(file: Path) -> tuple[Suite, WorldConfig]:
-    """A validated suite and its world; a UserError at file:line for anything wrong."""
+def load_suite(file: Path, scene: str | None = None) -> tuple[Suite, WorldConfig]:
+    """A validated suite and its world; a UserError at file:line for anything wrong. ``scene`` (by name, or a
+    file relative to the working directory) replaces the suite's; the suite returned names its scene so that
+    it loads from anywhere (a file's path made absolute)."""
     suite, source = read_model(file, Suite, "a suite is a mapping (suite:, tasks:, ...)")
     world = _world(suite, source)
+    if scene is not None:
+        suite = suite.model_copy(update={"scene": _absolute(scene, Path.cwd())})
+        start = load_scene(world, scene, named_at="--scene")
+    elif suite.scene is not None:
+        suite = suite.model_copy(update={"scene": _absolute(suite.scene, file.parent)})
+        start = load_scene(world, suite.scene, named_at=source.where(("scene",)))
+    else:
+        start = (
+            load_scene(world, world.scene, named_at=f"worlds/{world.folder.name}/world.yaml") if world.scene else None
+        )
     _check_names(suite, world, source)
-    _check_tasks(suite, source)
+    _check_scene_draw(suite, world, source)
+    _check_objects_in_scene(suite, world, start, source)
+    _check_tasks(suite, source, _names_scene(suite, world, start))
     return suite, world
+
+
+def suite_scene(suite: Suite, world: WorldConfig) -> SceneConfig | None:
+    """The scene a suite's episodes start from (checked when the suite was loaded): its own, else the world's."""
+    name = suite.scene or world.scene
+    return load_scene(world, name) if name is not None else None
+
+
+def _absolute(scene: str, base: Path) -> str:
+    """A scene file's path made absolute (from ``base``); a scene's name as it is."""
+    return str((base / scene).resolve()) if Path(scene).suffix in (".yaml", ".yml") else scene
 
 
 def _world(suite: Suite, source: YamlSource) -> WorldConfig:
@@ -99,8 +154,11 @@ def _world(suite: Suite, source: YamlSource) -> WorldConfig:
 
 
 def _check_names(suite: Suite, world: WorldConfig, source: YamlSource) -> None:
+    for index, name in enumerate(suite.objects):  # a world object, or a scene's ("coke 2", a second coke)
+        if world.object_of(name) is None:
+            hint = did_you_mean(name, world.objects)
+            raise UserError(f"unknown name '{name}'", where=source.where(("objects", index)), hint=hint)
     checks = [
-        (("objects",), suite.objects, world.objects),
         (("surfaces",), suite.surfaces, world.surfaces),
         (("randomize", "object_on"), suite.randomize.object_on, world.surfaces),
         (("randomize", "obstacles"), suite.randomize.obstacles, world.obstacles),
@@ -112,7 +170,69 @@ def _check_names(suite: Suite, world: WorldConfig, source: YamlSource) -> None:
                 raise UserError(f"unknown name '{name}'", where=source.where((*path, index)), hint=hint)
 
 
-def _check_tasks(suite: Suite, source: YamlSource) -> None:
+def _check_scene_draw(suite: Suite, world: WorldConfig, source: YamlSource) -> None:
+    """A random scene draws objects scenes can place, on known surfaces; the episode's {object} is one of them."""
+    draw = suite.randomize.scene
+    if draw is None:
+        return
+    placeable = world.placeable
+    if not placeable:
+        raise UserError(
+            f"world '{world.name}' has no objects a scene can place: its objects are fixed bodies of its model",
+            where=source.where(("randomize", "scene")),
+            hint="leave out randomize.scene, or use a world whose objects are models (kitchen)",
+        )
+    checks = [
+        (("randomize", "scene", "surfaces"), draw.surfaces, world.surfaces),
+        (("randomize", "scene", "among"), draw.among, placeable),
+    ]
+    for path, names, known in checks:
+        for index, name in enumerate(names):
+            if name not in known:
+                raise UserError(
+                    f"unknown name '{name}'", where=source.where((*path, index)), hint=did_you_mean(name, known)
+                )
+    for index, name in enumerate(suite.objects):
+        if name not in placeable:
+            raise UserError(
+                f"'{name}' is not an object a random scene can place",
+                where=source.where(("objects", index)),
+                hint=did_you_mean(name, placeable),
+            )
+
+
+def _check_objects_in_scene(suite: Suite, world: WorldConfig, scene: SceneConfig | None, source: YamlSource) -> None:
+    """Without a random scene, the episode's {object} must be an object of the run: the world's or its scene's."""
+    if suite.randomize.scene is not None:
+        return
+    present = _run_objects(world, scene)
+    for index, name in enumerate(suite.objects):
+        if name not in present:
+            where = f"scene '{scene.name}'" if scene is not None else f"world '{world.name}'"
+            raise UserError(
+                f"no '{name}' in {where}: an episode's object must be in the scene it starts from",
+                where=source.where(("objects", index)),
+                hint=did_you_mean(name, present) if present else "the scene places no objects",
+            )
+
+
+def _run_objects(world: WorldConfig, scene: SceneConfig | None) -> list[str]:
+    """The names of a run's objects: the world's fixed bodies and the scene's instances."""
+    fixed = [name for name, o in world.objects.items() if o.body is not None]
+    return fixed + ([name for name, _ in scene.instances()] if scene is not None else [])
+
+
+def _names_scene(suite: Suite, world: WorldConfig, scene: SceneConfig | None) -> SceneConfig | None:
+    """The scene whose object names expectations may use: the one episodes start from, or, for random scenes,
+    one with each object the draws may name (the episode's object is always the first of its kind)."""
+    draw = suite.randomize.scene
+    if draw is None:
+        return scene
+    names = list(dict.fromkeys([*suite.objects, *(draw.among or world.placeable)]))
+    return SceneConfig(objects=[Placement(object=name, on=draw.surfaces[0]) for name in names], name="random")
+
+
+def _check_tasks(suite: Suite, source: YamlSource, scene: SceneConfig | None = None) -> None:
     """Every task fills its slots, and its expectations (and a new command's) are valid conditions on the world."""
     for index, task in enumerate(suite.tasks):
         text = task.command or ""
@@ -121,20 +241,23 @@ def _check_tasks(suite: Suite, source: YamlSource) -> None:
                 raise UserError(
                     f"the task uses {{{slot}}} but the suite lists no {slot}s", where=source.where(("tasks", index))
                 )
-        _check_expect(task.expect, ("tasks", index, "expect"), suite, source)
+        _check_expect(task.expect, ("tasks", index, "expect"), suite, source, scene)
         if task.mission is not None and not (source.file.parent / task.mission).is_file():
             raise UserError(f"mission file not found: {task.mission}", where=source.where(("tasks", index, "mission")))
     for index, fault in enumerate(suite.faults.kinds):
         if fault.new_command is not None:
-            _check_expect(fault.new_command.expect, ("faults", "kinds", index, "new_command", "expect"), suite, source)
+            path = ("faults", "kinds", index, "new_command", "expect")
+            _check_expect(fault.new_command.expect, path, suite, source, scene)
 
 
-def _check_expect(expect: list[dict[str, Any]], path: tuple, suite: Suite, source: YamlSource) -> None:
+def _check_expect(
+    expect: list[dict[str, Any]], path: tuple, suite: Suite, source: YamlSource, scene: SceneConfig | None
+) -> None:
     """Success conditions checked the way a mission's are (kinds, fields, names), with the first names drawn."""
     slots = {"object": (suite.objects or [""])[0], "surface": (suite.surfaces or [""])[0]}
     probe = {"mission": "check", "world": suite.world, "robot": suite.robot, "tree": {"wait": {"seconds": 0}}}
     try:
-        MissionLoader().load_data({**probe, "success": fill(expect, slots)}, name="<expect>")
+        MissionLoader(scene=scene).load_data({**probe, "success": fill(expect, slots)}, name="<expect>")
     except UserError as error:
         raise UserError(f"expect: {error.message}", where=source.where(path), hint=error.hint) from None
 

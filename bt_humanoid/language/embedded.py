@@ -529,7 +529,7 @@ def _spoken(name: str) -> str:
 
 def _name_of(tracked: TrackedObject, context: PlanningContext) -> str:
     """What to call an object in a mission: the world's name for it, else the robot's own id."""
-    if tracked.name in context.world.objects:
+    if context.world.object_of(tracked.name) is not None:  # the world's name, or a scene's ("coke 2")
         return tracked.name
     named = [
         name

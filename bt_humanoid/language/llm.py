@@ -250,7 +250,7 @@ def world_summary(context: PlanningContext) -> str:
         "surfaces": list(world.surfaces),
         "objects_seen": [
             {
-                "name": o.name if o.name in world.objects else o.id,
+                "name": o.name if world.object_of(o.name) is not None else o.id,  # "coke 2": a scene's second
                 "kind": o.kind,
                 "colour": o.colour,
                 "on": surface_of(o.position),

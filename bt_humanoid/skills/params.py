@@ -43,9 +43,10 @@ def check_name(value: str | None, valid: Iterable[str], parameter: str, what: st
 
 
 def check_object(value: str | None, world: WorldConfig, parameter: str = OBJECT_PARAMETER) -> list[tuple[str, str]]:
-    """Compile-time check of an object parameter: a name the world gives, or a phrase to ground when it runs."""
+    """Compile-time check of an object parameter: a name the world gives (or one of a scene's: "coke 2" is a
+    second coke), or a phrase to ground when it runs."""
     names = list(world.objects)
-    if value is None or value in names or describes_an_object(value, [*names, *world.surfaces]):
+    if value is None or world.object_of(value) is not None or describes_an_object(value, [*names, *world.surfaces]):
         return []
     example = 'or a description such as "the red cube" or "the cup on the counter"'
     return [(parameter, f"unknown object '{value}' ({did_you_mean(value, names)}), {example}")]
