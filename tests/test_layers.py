@@ -27,6 +27,7 @@ LAYERS = {
     "viz": 9,
     "commanding": 10,
     "testing": 11,
+    "training": 11,
     "benchmarks": 12,
     "cli": 12,
     "evaluation": 13,

@@ -58,10 +58,34 @@ class Detection:
     pixels: int
     yaw_known: bool = True  # false for a mug whose handle was not seen (its yaw is a guess)
     occluded: bool = False  # partly hidden behind the robot's own arm: what shows is a cut-off part of it
+    identity: str | None = None  # which of the world's objects it is, when a recogniser tells them apart by look
+
+
+@dataclass
+class Region:
+    """A connected patch of the image standing on a support surface: one object, or a part of one."""
+
+    rows: np.ndarray  # pixel rows
+    cols: np.ndarray  # pixel columns
+    surface: SupportSurface
+    points: np.ndarray  # (N, 3) world points of its pixels
+    colours: np.ndarray  # (N, 3) RGB of its pixels
+    occluded: bool  # touches the robot's own body in the image: it may be cut off
 
 
 def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
-    """Objects resting on any of ``surfaces`` in the frame."""
+    """Objects resting on any of ``surfaces`` in the frame, told apart by shape rules."""
+    detections = []
+    for region in segment(frame, surfaces):
+        detection = _describe(region.points, region.colours, region.surface, frame.position)
+        if detection is not None:
+            detection.occluded = region.occluded
+            detections.append(detection)
+    return without_fragments(detections)
+
+
+def segment(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Region]:
+    """The image's regions that stand on one of ``surfaces``: points above it, split at depth jumps."""
     points = frame.points()
     candidate = np.zeros(frame.depth.shape, dtype=bool)
     surface_of = np.full(frame.depth.shape, -1, dtype=int)
@@ -76,17 +100,15 @@ def detect(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Detection]:
     count, labels, stats, _ = cv2.connectedComponentsWithStats((candidate & ~edges).astype(np.uint8), connectivity=4)
     labels = _reattach(labels, candidate & edges, frame.depth)
     beside_robot = _beside(frame.hidden)
-    detections = []
+    regions = []
     for label in range(1, count):
         if stats[label, cv2.CC_STAT_AREA] < MIN_PIXELS:
             continue
         rows, cols = np.nonzero(labels == label)
         surface = surfaces[int(np.bincount(surface_of[rows, cols]).argmax())]
-        detection = _describe(points[rows, cols], frame.rgb[rows, cols], surface, frame.position)
-        if detection is not None:
-            detection.occluded = bool(beside_robot is not None and beside_robot[rows, cols].any())
-            detections.append(detection)
-    return _without_fragments(detections)
+        occluded = bool(beside_robot is not None and beside_robot[rows, cols].any())
+        regions.append(Region(rows, cols, surface, points[rows, cols], frame.rgb[rows, cols], occluded))
+    return regions
 
 
 def _beside(hidden: np.ndarray | None) -> np.ndarray | None:
@@ -97,7 +119,7 @@ def _beside(hidden: np.ndarray | None) -> np.ndarray | None:
     return cv2.dilate(hidden.astype(np.uint8), np.ones((size, size), np.uint8)).astype(bool)
 
 
-def _without_fragments(detections: list[Detection]) -> list[Detection]:
+def without_fragments(detections: list[Detection]) -> list[Detection]:
     """Drop a region that lies within a bigger one's footprint: a part of it cut off by a depth jump."""
     kept: list[Detection] = []
     for detection in sorted(detections, key=lambda d: -d.pixels):
@@ -140,17 +162,17 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
         return None
     # shape cues that one oblique view gives reliably: the silhouette's width across the line of sight, how much
     # of the object is its flat top and how full that top's outline is, and how well a sphere fits the points
-    width = _extent(points[:, :2], _across(points[:, :2], eye))
+    width = extent(points[:, :2], across(points[:, :2], eye))
     if width < MIN_WIDTH:
         return None  # a sliver: the edge of something mostly hidden, or a fragment cut off at a depth jump
     flatness = float(np.mean(heights > top - FLAT_BAND))
     # a flat top as wide as the thing is its lid, and outlines its body (a bottle's cap is narrower)
-    lid = len(flat_top) >= WELL_SEEN_TOP and _circle(flat_top)[1] > LID_WIDTH * width
-    centre, diameter, handle = _cylinder(band, flat_top if lid else None)
+    lid = len(flat_top) >= WELL_SEEN_TOP and circle(flat_top)[1] > LID_WIDTH * width
+    centre, diameter, handle = cylinder_outline(band, flat_top if lid else None)
     if len(points) < HANDLE_VIEW:
         handle = None  # a few pixels of outline do not show a handle reliably
     yaw_known = True
-    ball = _resting_sphere(points, surface.height, top)
+    ball = resting_sphere(points, surface.height, top)
     if ball is not None:  # first: a ball half hidden looks narrow and tall
         kind = "ball"
         centre, diameter = ball[:2], 2.0 * float(ball[2])
@@ -180,7 +202,7 @@ def _describe(points: np.ndarray, colours: np.ndarray, surface: SupportSurface, 
     return Detection(kind, colour, position, size, yaw, surface.name, len(points), yaw_known)
 
 
-def _resting_sphere(points: np.ndarray, surface_height: float, top: float) -> np.ndarray | None:
+def resting_sphere(points: np.ndarray, surface_height: float, top: float) -> np.ndarray | None:
     """Centre (x, y) and radius of a ball the points lie on, if they do and it rests on the surface; else None.
 
     A least-squares sphere through the points (|p - c|² = r² is linear in c and r² - |c|²); a ball also sits
@@ -214,14 +236,14 @@ def _boxy(flat_top: np.ndarray, flatness: float, top: float, width: float) -> bo
     return flatness >= BOX_FLATNESS or (top < 0.8 * width and flatness >= 0.22)
 
 
-def _across(xy: np.ndarray, eye: np.ndarray) -> np.ndarray:
+def across(xy: np.ndarray, eye: np.ndarray) -> np.ndarray:
     """Unit vector on the floor across the line of sight from the camera to these points."""
     sight = xy.mean(axis=0) - eye[:2]
     sight /= max(float(np.hypot(*sight)), 1e-9)
     return np.array([-sight[1], sight[0]])
 
 
-def _extent(xy: np.ndarray, direction: np.ndarray) -> float:
+def extent(xy: np.ndarray, direction: np.ndarray) -> float:
     if len(xy) < 2:
         return 0.0
     projected = xy @ direction
@@ -240,23 +262,23 @@ def _area(xy: np.ndarray) -> float:
     return float(cv2.contourArea(cv2.convexHull(xy.astype(np.float32)))) if len(xy) >= 3 else 0.0
 
 
-def _circle(xy: np.ndarray) -> tuple[np.ndarray, float]:
+def circle(xy: np.ndarray) -> tuple[np.ndarray, float]:
     (cx, cy), radius = cv2.minEnclosingCircle(xy.astype(np.float32))
     return np.array([cx, cy]), 2.0 * radius
 
 
-def _cylinder(xy: np.ndarray, rim: np.ndarray | None) -> tuple[np.ndarray, float, np.ndarray | None]:
+def cylinder_outline(xy: np.ndarray, rim: np.ndarray | None) -> tuple[np.ndarray, float, np.ndarray | None]:
     """Body centre and diameter of a round footprint, and the direction of a handle sticking out of it (if any).
 
     The rim (the flat top's points), when seen well, outlines the body alone: a mug's handle stays below it.
     Otherwise the body is the bulk of the footprint, and a handle a lump further out on one side.
     """
     if rim is not None:
-        body_centre, body_diameter = _circle(rim)
+        body_centre, body_diameter = circle(rim)
     else:
-        centre, _ = _circle(xy)
+        centre, _ = circle(xy)
         distance = np.hypot(*(xy - centre).T)
-        body_centre, body_diameter = _circle(xy[distance <= np.percentile(distance, 80)])
+        body_centre, body_diameter = circle(xy[distance <= np.percentile(distance, 80)])
     offsets = xy - body_centre
     distance = np.hypot(*offsets.T)
     outside = distance > body_diameter / 2 + 0.008

@@ -2,9 +2,9 @@
 
 A detection joins the tracked object it lies closest to (same surface,
 within a few centimetres), moving its estimate towards the new one and
-adding a vote for its kind and colour: one view may take a mug with its
-handle hidden for a can, the next view sees the handle, and the votes
-settle it. A detection near no tracked object starts a new one. A tracked
+adding a vote for its kind, colour and identity: one view may take a mug
+with its handle hidden for a can, or a coke seen from afar for a pepsi, the
+next view sees better, and the votes settle it. A detection near no tracked object starts a new one. A tracked
 object that should be in view (inside the image, in range, nothing nearer
 in front of it, not behind the robot's own arm) but is not seen loses
 confidence; at zero it is gone. A detection cut off by the robot's own arm
@@ -28,6 +28,7 @@ GONE = 0.15  # below this confidence an object is no longer believed to be there
 SIGHT_RANGE = 2.0  # m: a farther object may go undetected, so not seeing it there says nothing
 MIN_APPARENT = 8  # pixels across an object must span before not seeing it counts against it
 BORDER = 8  # pixels: an object this close to the image's edge may be cut off
+UPRIGHT = ("bottle", "mug", "can", "bag")  # kinds carried upright (they spill or fall over otherwise)
 
 
 def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame) -> None:
@@ -63,7 +64,7 @@ def _reidentify(belief: WorldModel) -> None:
     objects = belief.objects
 
     def alike(a: TrackedObject, b: TrackedObject) -> bool:
-        return a.kind == b.kind and a.colour == b.colour
+        return a.kind == b.kind and a.colour == b.colour and a.identity == b.identity
 
     gone = [o for o in objects.values() if o.confidence <= 0.0 and o.held_by is None]
     for old in gone:
@@ -93,7 +94,7 @@ def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject
     number = 1 + sum(1 for key in used if key.startswith(f"{detection.kind}-"))
     tracked = TrackedObject(
         id=f"{detection.kind}-{number}",
-        name=f"{detection.colour} {detection.kind}",
+        name=detection.identity or f"{detection.colour} {detection.kind}",
         kind=detection.kind,
         colour=detection.colour,
         position=detection.position.copy(),
@@ -103,9 +104,10 @@ def _new(belief: WorldModel, detection: Detection, time: float) -> TrackedObject
         confidence=GAIN,
         last_seen=time,
         first_seen=time,
-        keep_upright=detection.kind in ("bottle", "mug", "can"),
+        keep_upright=detection.kind in UPRIGHT,
+        identity=detection.identity,
     )
-    tracked.votes[(detection.kind, detection.colour)] += 1
+    tracked.votes[(detection.kind, detection.colour, detection.identity)] += 1
     belief.update(tracked)
     return tracked
 
@@ -120,13 +122,13 @@ def _update(tracked: TrackedObject, detection: Detection, time: float) -> None:
     tracked.position = (1 - NEW_WEIGHT) * tracked.position + NEW_WEIGHT * detection.position
     tracked.size = (1 - NEW_WEIGHT) * tracked.size + NEW_WEIGHT * detection.size
     _confirm(tracked, time)
-    tracked.votes[(detection.kind, detection.colour)] += 1
-    (kind, colour), _ = tracked.votes.most_common(1)[0]
+    tracked.votes[(detection.kind, detection.colour, detection.identity)] += 1
+    (kind, colour, identity), _ = tracked.votes.most_common(1)[0]
     if detection.yaw_known or not tracked.yaw_known:  # a seen handle beats any guess
         tracked.yaw, tracked.yaw_known = detection.yaw, detection.yaw_known
-    tracked.kind, tracked.colour = kind, colour
-    tracked.name = f"{colour} {kind}"
-    tracked.keep_upright = kind in ("bottle", "mug", "can")
+    tracked.kind, tracked.colour, tracked.identity = kind, colour, identity
+    tracked.name = identity or f"{colour} {kind}"
+    tracked.keep_upright = kind in UPRIGHT
 
 
 def _should_be_visible(tracked: TrackedObject, frame: RgbdFrame) -> bool:

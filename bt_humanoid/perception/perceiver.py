@@ -4,7 +4,9 @@ It runs at a low rate while a mission runs (a rendered frame costs about
 20 ms of wall time) and on demand when a skill needs a fresh look
 (``look()``). The robot's own body is masked out of every frame from its
 kinematic model (a segmentation render of the robot's geoms), as a real
-robot filters itself out of its point cloud.
+robot filters itself out of its point cloud. A world whose world.yaml names a
+trained detector has its objects recognised by it (``learned_detector.py``);
+any other world's by shape rules (``detector.py``).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 
 from bt_humanoid.perception.detector import Detection, detect
 from bt_humanoid.perception.fusion import integrate
+from bt_humanoid.perception.learned_detector import LearnedDetector
 from bt_humanoid.perception.rgbd_camera import RgbdCamera, RgbdFrame
 from bt_humanoid.perception.world_model import WorldModel
 from bt_humanoid.sim.simulation import Simulation
@@ -41,6 +44,7 @@ class Perceiver:
         )
         self._segmentation = mujoco.Renderer(sim.model, config.height, config.width)
         self._segmentation.enable_segmentation_rendering()
+        self.learned = LearnedDetector.for_world(sim.world) if sim.world.detector is not None else None
         self.frames = 0
         self.look_times: list[float] = []  # wall seconds per look (capture, detection, fusion), for benchmarks
 
@@ -66,7 +70,8 @@ class Perceiver:
             return []  # no frame: the belief keeps what it had
         self._mask_robot(frame)
         belief = self.world_model()
-        detections = detect(frame, list(belief.surfaces.values()))
+        surfaces = list(belief.surfaces.values())
+        detections = self.learned.detect(frame, surfaces) if self.learned is not None else detect(frame, surfaces)
         integrate(belief, detections, frame)
         self.frames += 1
         self.look_times.append(time.perf_counter() - started)
@@ -74,10 +79,13 @@ class Perceiver:
 
     def _mask_robot(self, frame: RgbdFrame) -> None:
         """The robot's own pixels read as far away: nothing there for the detector."""
-        renderer = self._segmentation
-        renderer.update_scene(self.sim.data, camera=self.camera.camera)
-        segmentation = renderer.render()
-        geom = segmentation[..., 0]
-        is_geom = segmentation[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
-        robot = is_geom & self._robot_geoms[np.clip(geom, 0, len(self._robot_geoms) - 1)]
-        frame.hide(robot)
+        geoms = rendered_geoms(self._segmentation, self.sim.data, self.camera.camera)
+        frame.hide((geoms >= 0) & self._robot_geoms[np.maximum(geoms, 0)])
+
+
+def rendered_geoms(renderer: mujoco.Renderer, data: mujoco.MjData, camera: int) -> np.ndarray:
+    """The geom each pixel shows, -1 where none (a segmentation render from ``camera``)."""
+    renderer.update_scene(data, camera=camera)
+    segmentation = renderer.render()
+    is_geom = segmentation[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
+    return np.where(is_geom, segmentation[..., 0], -1)

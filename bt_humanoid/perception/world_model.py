@@ -35,7 +35,7 @@ class TrackedObject:
     held_by: str | None = None  # gripper side while the robot holds it
     grip_offset: float = 0.0  # m the grip site sits above the centre, while held
     yaw_known: bool = True  # false while a mug's handle has not been seen (its yaw is a guess)
-    votes: Counter = field(default_factory=Counter)  # (kind, colour) → sightings, when perception tracks it
+    votes: Counter = field(default_factory=Counter)  # (kind, colour, identity) → sightings, when perception tracks it
     identity: str | None = None  # which of the world's objects it is ("coke"), where its look tells them apart
 
     @property
@@ -84,9 +84,10 @@ class WorldModel:
         named = [o for o in present if o.name == name]
         if not named and name in self.vocabulary:
             kind, colour = self.vocabulary[name]
-            named = [o for o in present if o.kind == kind and o.colour == colour]
+            unnamed = [o for o in present if o.identity is None]  # a recognised coke is not "a red can" for a pepsi
+            named = [o for o in unnamed if o.kind == kind and o.colour == colour]
             if not named:  # one view may take a mug for a can, or a cube for a box: the right colour and a look-alike
-                named = [o for o in present if o.colour == colour and kind in LOOK_ALIKES.get(o.kind, ())]
+                named = [o for o in unnamed if o.colour == colour and kind in LOOK_ALIKES.get(o.kind, ())]
         if named:
             return max(named, key=lambda o: (o.held_by is not None, o.confidence, o.last_seen))
         if any(o.name == name for o in self.objects.values()):
