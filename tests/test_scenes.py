@@ -129,6 +129,15 @@ def test_a_mission_names_its_scene_and_the_command_line_overrides_it(tmp_path):
     assert MissionLoader().load_file(mission).scene is None  # the apartment has none
 
 
+def test_a_mission_judged_on_an_object_its_robot_s_scene_lacks_is_refused_before_it_runs(kitchen, blind):
+    spec = MissionLoader().load_text(  # checked against the default scene, which has an apple
+        "mission: m\nworld: kitchen\ntree:\n  wait: {seconds: 1}\nsuccess:\n  - upright: apple\n", "m.yaml"
+    )
+    stack = RobotStack(kitchen, blind, scene=load_scene(kitchen, "three_cokes"))
+    with pytest.raises(UserError, match=r"success: no 'apple' in this run \(scene 'three_cokes'\)"):
+        MissionRun(stack, spec)
+
+
 # --- held from the start -----------------------------------------------------------------------------------
 
 

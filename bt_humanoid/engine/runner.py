@@ -18,7 +18,7 @@ from bt_humanoid.engine.executor import Executor
 from bt_humanoid.engine.settings import resolve_safety
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.engine.verdict import ConditionResult, check_condition
-from bt_humanoid.errors import UserError
+from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.navigation.navigator import Navigator
 from bt_humanoid.perception.perceiver import Perceiver
@@ -95,6 +95,15 @@ class MissionRun:
             raise UserError(
                 f"mission '{header.mission}' is for {header.world}/{header.robot}; "
                 f"this robot is {stack.robot_config.name} in {stack.world.name}"
+            )
+        absent = [name for name in _objects_judged(spec) if name not in stack.sim.object_bodies]
+        if absent:  # judged in ground truth at the end: a name the run lacks cannot be judged
+            scene = stack.sim.scene
+            raise UserError(
+                f"success: no '{absent[0]}' in this run"
+                + (f" (scene '{scene.name}')" if scene is not None else f" (world '{stack.world.name}')"),
+                where=spec.file.name if spec.file is not None else None,
+                hint=did_you_mean(absent[0], stack.sim.object_bodies),
             )
         self.stack, self.spec = stack, spec
         robot_config = stack.robot_config
@@ -205,6 +214,20 @@ class MissionRun:
             if event["event"] == "status" and event["new"] == "FAILURE" and event["node"] in skills:
                 return f"{event['node']}: {event.get('feedback') or 'failed'}"
         return None
+
+
+def _objects_judged(spec: MissionSpec) -> list[str]:
+    """The objects the mission's success conditions name (the first of a pair: an object on a surface)."""
+    names = []
+    for condition in spec.header.success:
+        for kind, value in condition.model_dump().items():
+            if kind in ("on", "inside"):
+                names.append(value[0])
+            elif kind in ("in_hand", "upright", "delivered"):
+                names.append(value)
+            elif kind == "near":
+                names.append(value["object"])
+    return names
 
 
 def _trunk(sim: Simulation) -> set[int]:

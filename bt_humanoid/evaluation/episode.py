@@ -230,7 +230,8 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
 def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, stack: RobotStack, figures: dict):
     """The episode's validated mission, or why there is none (a string)."""
     if task.mission is not None:
-        spec = MissionLoader().load_file(Path(suite_file).parent / task.mission)
+        # the episode's scene, not the mission's: success conditions name the objects of this run
+        spec = MissionLoader(scene=stack.sim.scene).load_file(Path(suite_file).parent / task.mission)
         spec.header.safety.time_budget = suite.time_budget
         return spec
     return _planned(fill(task.command, draw.slots), suite, stack, figures)
