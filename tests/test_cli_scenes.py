@@ -14,8 +14,10 @@ import pytest
 from bt_humanoid.cli import EXIT_INVALID, EXIT_OK, plan_main, run_main, validate_main
 from bt_humanoid.evaluation.command import eval_main
 from bt_humanoid.evaluation.suite import load_suite
+from bt_humanoid.sim.scene_config import scene_names
+from bt_humanoid.sim.world_config import load_world_config
 
-SCENES = "default, holding_coke, three_cokes"
+SCENES = ", ".join(scene_names(load_world_config("kitchen")))  # every scene of the kitchen's scenes/ folder
 
 
 def write(folder: Path, name: str, text: str) -> Path:
@@ -41,6 +43,7 @@ def test_a_mission_naming_an_unknown_scene_is_refused_at_its_line(tmp_path, caps
     assert run_main([str(kitchen_mission(tmp_path, "breakfast")), "--no-live"]) == EXIT_INVALID
     err = one_error(capsys)
     assert "m.yaml:3" in err and "unknown scene 'breakfast' of world 'kitchen'" in err and f"valid: {SCENES}" in err
+    assert {"default", "holding_coke", "three_cokes"} <= set(SCENES.split(", "))
 
 
 def test_an_unknown_scene_on_the_command_line_is_named_as_the_option(tmp_path, capsys):
