@@ -1,6 +1,6 @@
 """Train the learned recogniser of a world's objects on views rendered from the simulator.
 
-    python -m bt_humanoid.training.detector --world kitchen            # the committed weights (about 20 min)
+    python -m bt_humanoid.training.detector --world kitchen            # the committed weights (10-20 min)
     python -m bt_humanoid.training.detector --views 40 --epochs 1 --out /tmp/d   # a quick check that it runs
 
 The recipe: random views (``views.py``) from the seed's training stream; every
@@ -136,9 +136,9 @@ def accuracy(recogniser: Recogniser, data: Dataset) -> dict[str, float]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--world", default="kitchen")
-    parser.add_argument("--views", type=int, default=4000, help="training views (default 4000)")
-    parser.add_argument("--validation-views", type=int, default=400)
-    parser.add_argument("--epochs", type=int, default=14)
+    parser.add_argument("--views", type=int, default=6000, help="training views (default 6000)")
+    parser.add_argument("--validation-views", type=int, default=600)
+    parser.add_argument("--epochs", type=int, default=16)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, help="folder for weights and recipe (default: the world's detector/)")
     args = parser.parse_args(argv)

@@ -1,0 +1,33 @@
+"""Typed commands in the kitchen, end to end: the learned detector tells a coke from five other cans."""
+
+import numpy as np
+import pytest
+
+from bt_humanoid.cli import EXIT_OK, run_main
+from bt_humanoid.engine.verdict import HANDOVER_REACH
+
+
+@pytest.mark.sim
+def test_bring_me_a_coke_brings_the_coke_not_another_can(monkeypatch, capsys):
+    from bt_humanoid.sim import simulation
+
+    built: list[simulation.Simulation] = []
+    original = simulation.Simulation.__init__
+
+    def keeping(self, *args, **kwargs) -> None:
+        built.append(self)
+        original(self, *args, **kwargs)
+
+    monkeypatch.setattr(simulation.Simulation, "__init__", keeping)
+    argv = ["--world", "kitchen", "--scene", "cans_on_table", "--command", "bring me a coke", "--no-live"]
+    assert run_main(argv) == EXIT_OK
+    assert "I will pick up the coke and bring it to you" in capsys.readouterr().out
+    (sim,) = built  # judged on the run's own simulation, after it ended
+    from bt_humanoid.sim.ground_truth import GroundTruth
+
+    truth = GroundTruth(sim)
+    person = truth.person_position("person")
+    coke = truth.object_position("coke")
+    assert np.hypot(*(coke[:2] - person[:2])) <= HANDOVER_REACH  # handed over: let go within the person's reach
+    for other in ("pepsi", "7up", "red bull", "lime soda", "grapefruit soda"):
+        assert truth.rests_on(other, "table") and truth.upright(other), f"the {other} was moved"
