@@ -31,3 +31,21 @@ def test_bring_me_a_coke_brings_the_coke_not_another_can(monkeypatch, capsys):
     assert np.hypot(*(coke[:2] - person[:2])) <= HANDOVER_REACH  # handed over: let go within the person's reach
     for other in ("pepsi", "7up", "red bull", "lime soda", "grapefruit soda"):
         assert truth.rests_on(other, "table") and truth.upright(other), f"the {other} was moved"
+
+
+def test_a_coke_among_three_alike_is_any_of_them_not_a_question():
+    from bt_humanoid.commanding import plan_command
+    from bt_humanoid.engine.stack import RobotStack
+
+    stack = RobotStack.load("kitchen", "wheeled_humanoid", scene="three_cokes")
+    try:
+        stack.look()
+        seen = [o.name for o in stack.context.world_model.present()]
+        assert seen.count("coke") == 3  # told apart from the pepsi and the 7up, alike among themselves
+        outcome = plan_command("bring me a coke", stack.planning_context(), lambda question: None)
+        assert outcome.spec is not None, outcome.plan.say
+        assert outcome.plan.mission["tree"]["sequence"][0] == {"take": {"object": "coke"}}
+        asked = plan_command("bring me a can", stack.planning_context(), lambda question: None)
+        assert asked.plan.kind == "question"  # cans that differ: which one is a fair question
+    finally:
+        stack.close()

@@ -389,6 +389,9 @@ class EmbeddedPlanner:
             return name
         if grounding.verdict == "ambiguous":
             options = [_name_of(o, context) for o in grounding.tied]
+            if len(set(options)) == 1:  # three cokes alike: "a coke" is any of them, find takes the surest
+                state.last = options[:1]
+                return options[0]
             raise Question(Choice(command="", phrase=phrase, options=options), _which(options))
         named = _by_vocabulary(bare, context)
         if len(named) == 1:  # known by name, not seen yet: find will look for it
