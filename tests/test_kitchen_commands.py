@@ -49,3 +49,17 @@ def test_a_coke_among_three_alike_is_any_of_them_not_a_question():
         assert asked.plan.kind == "question"  # cans that differ: which one is a fair question
     finally:
         stack.close()
+
+
+def test_a_condition_on_one_of_several_alike_holds_for_any_of_them():
+    from bt_humanoid.engine.stack import RobotStack
+    from bt_humanoid.engine.verdict import _any
+
+    stack = RobotStack.load("kitchen", "wheeled_humanoid", scene="three_cokes")
+    try:
+        assert _any("coke", stack.truth, lambda name: name == "coke 3") == "coke 3"  # any coke brought is a coke
+        assert _any("coke", stack.truth, lambda name: False) == "coke"  # none: judged (and reported) on the named one
+        assert _any("coke 2", stack.truth, lambda name: True) == "coke 2"  # an instance named is that one
+        assert _any("pepsi", stack.truth, lambda name: False) == "pepsi"
+    finally:
+        stack.close()

@@ -6,6 +6,7 @@ This is judging, not the mission language: only the engine (after a run), tests 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from bt_humanoid.control.base_driver import wrap_angle
@@ -39,10 +40,11 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
         x, y, z = truth.object_position(obj)
         return ConditionResult(f"{obj} on {surface}", holds, f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})")
     if isinstance(condition, InsideCondition):
-        obj, container = condition.inside
+        named, container = condition.inside
+        obj = _any(named, truth, lambda o: truth.inside(o, container))
         x, y, z = truth.object_centre(obj)
         return ConditionResult(
-            f"{obj} in the {container}", truth.inside(obj, container), f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})"
+            f"{named} in the {container}", truth.inside(obj, container), f"{obj} at ({x:.2f}, {y:.2f}, {z:.2f})"
         )
     if isinstance(condition, AtCondition):
         target = condition.at
@@ -56,7 +58,7 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
         holds = distance <= tolerance and heading <= yaw_tolerance
         return ConditionResult(f"robot at {place}", holds, f"{distance:.3f} m and {heading:.1f}° from its pose")
     if isinstance(condition, InHandCondition):
-        side = truth.in_hand(condition.in_hand)
+        side = truth.in_hand(_any(condition.in_hand, truth, lambda o: truth.in_hand(o) is not None))
         return ConditionResult(f"{condition.in_hand} in hand", side is not None, f"held by {side or 'no'} gripper")
     if isinstance(condition, UprightCondition):
         holds = truth.upright(condition.upright)
@@ -77,11 +79,26 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
         holds = width > 0.9 * open_width if state == "open" else width < 0.5 * open_width
         return ConditionResult(f"{side} gripper {state}", holds, f"jaws {width * 100:.1f} cm apart")
     if isinstance(condition, DeliveredCondition):
-        obj = condition.delivered
-        x, y, _ = truth.object_position(obj)
-        distance, person = min((math.dist((x, y), truth.person_position(p)[:2]), p) for p in truth.sim.world.people)
-        held = truth.in_hand(obj)
-        holds = held is None and distance <= HANDOVER_REACH
-        detail = f"in the {held} hand" if held else f"{distance:.2f} m from the {person}"
-        return ConditionResult(f"{obj} handed over", holds, detail)
+        named = condition.delivered
+        obj = _any(named, truth, lambda o: _handed_over(o, truth)[0])
+        holds, detail = _handed_over(obj, truth)
+        return ConditionResult(f"{named} handed over", holds, detail if obj == named else f"{obj}: {detail}")
     raise AssertionError(f"unhandled condition {condition!r}")
+
+
+def _handed_over(obj: str, truth: GroundTruth) -> tuple[bool, str]:
+    """Let go within reach of a person, and how far from the nearest."""
+    x, y, _ = truth.object_position(obj)
+    distance, person = min((math.dist((x, y), truth.person_position(p)[:2]), p) for p in truth.sim.world.people)
+    held = truth.in_hand(obj)
+    return (
+        held is None and distance <= HANDOVER_REACH,
+        f"in the {held} hand" if held else f"{distance:.2f} m from the {person}",
+    )
+
+
+def _any(named: str, truth: GroundTruth, holds: Callable[[str], bool]) -> str:
+    """The object a condition judges: ``named`` itself, or, where a scene has several of it ("coke", "coke 2"),
+    the first of them for which ``holds`` (any coke brought is a coke brought), else ``named``."""
+    alike = [name for name, kind in truth.sim.object_kinds.items() if kind == named]
+    return next((name for name in alike if holds(name)), named) if len(alike) > 1 else named
