@@ -2,10 +2,13 @@
 on real physics judged in ground truth."""
 
 import math
+from types import SimpleNamespace
 
+import mujoco
 import numpy as np
 import pytest
 
+from bt_humanoid.benchmarks.kitchen_manipulation import Kitchen, Trial, mission_of, scene_of
 from bt_humanoid.control.grasping import (
     OPENING_MARGIN,
     PAD_HALF_HEIGHT,
@@ -14,9 +17,12 @@ from bt_humanoid.control.grasping import (
     hand_yaws,
     plan_grasp,
 )
+from bt_humanoid.control.wbc.limits import JointRangeLimit
+from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.perception.world_model import TrackedObject
 from bt_humanoid.sim.simulation import Simulation
-from bt_humanoid.testing.told import told_objects
+from bt_humanoid.testing.scenario import Scenario, load_mission
+from bt_humanoid.testing.told import told_objects, told_stack
 
 OPENING = 0.13  # m between the open pads of the wheeled humanoid's grippers
 TABLE = 0.75  # m: the kitchen table's top
@@ -125,3 +131,122 @@ def test_every_kitchen_object_has_a_grasp_from_the_natural_hand_yaw_at_any_turn(
             grasp = plan_grasp(thing, thing.bottom, 0.0, OPENING)
             assert grasp.width <= OPENING - OPENING_MARGIN, thing.name
             assert grasp.position[2] - PAD_HALF_HEIGHT > thing.bottom, thing.name  # pads above the surface
+
+
+def _finger_touches_forearm(sim: Simulation, wrist_pitch: float, opening: float) -> bool:
+    """Posed (no physics step): does a finger of the right hand, opened ``opening`` each, touch its forearm?"""
+    model, data = sim.model, sim.data
+    for joint, value in {"r_wrist_pitch": wrist_pitch, "r_finger_a": opening, "r_finger_b": opening}.items():
+        data.qpos[model.joint(joint).qposadr[0]] = value
+    mujoco.mj_forward(model, data)
+    forearm = model.body("r_forearm").id
+    fingers = {model.body("r_finger_a").id, model.body("r_finger_b").id}
+    pairs = ({model.geom_bodyid[c.geom1], model.geom_bodyid[c.geom2]} for c in data.contact[: data.ncon])
+    return any(forearm in pair and pair & fingers for pair in pairs)
+
+
+def test_within_the_grippers_open_range_the_fingers_open_wide_clear_of_the_forearm():
+    sim = Simulation.load("kitchen", "wheeled_humanoid")
+    gripper = sim.robot.grippers["right"]
+    low, high = gripper.open_range["r_wrist_pitch"]
+    ready = sim.robot.postures["ready"]
+    for joint in ("torso_lift", "r_shoulder_pitch", "r_shoulder_roll", "r_elbow", "r_wrist_roll", "r_wrist_yaw"):
+        sim.data.qpos[sim.model.joint(joint).qposadr[0]] = ready[joint]
+    assert low <= ready["r_wrist_pitch"] <= high  # grasps start inside it
+    assert not _finger_touches_forearm(sim, high, gripper.open)
+    assert _finger_touches_forearm(sim, high + 0.1, gripper.open)  # beyond it the fingers jam on the forearm
+
+
+def test_a_joint_range_limit_holds_a_joint_inside_and_brings_one_outside_back():
+    kinematics = SimpleNamespace(joints=["a", "r_wrist_pitch"], positions=np.array([0.0, 1.6]))
+    limit = JointRangeLimit({"r_wrist_pitch": (-2.0, 1.7)}, gain=0.5)
+    inside = limit.inequality(kinematics, 0.01)
+    step_up = np.array([0.0, 0.06])  # to 1.66: more than half the 0.1 rad of slack
+    assert np.all(inside.G @ np.array([0.0, 0.04]) >= inside.lower) and not np.all(inside.G @ step_up >= inside.lower)
+    kinematics.positions = np.array([0.0, 1.8])  # started outside (the old ready posture)
+    outside = limit.inequality(kinematics, 0.01)
+    assert not np.all(outside.G @ np.zeros(2) >= outside.lower)  # holding still is not allowed
+    assert np.all(outside.G @ np.array([0.0, -0.001]) >= outside.lower)  # coming back in is
+
+
+# --------------------------------------------------------------------------- on real physics, told where things are
+
+TILTED = math.radians(15.0)  # what counts as knocked over
+FLUNG = math.sqrt(2 * 9.81 * 0.01)  # m/s: faster than a fall of 1 cm (put lets go 5 mm above the surface)
+
+
+@pytest.fixture(scope="module")
+def kitchen():
+    return Kitchen.load()
+
+
+def _run(kitchen, trial, success=()):
+    """Run a benchmark trial's mission with the object alone in the kitchen; also the object's worst tilt (rad)
+    and its fastest speed while out of the hand, sampled every control period."""
+    stack = told_stack(kitchen.world, kitchen.robot, scene=scene_of(kitchen, trial))
+    run = MissionRun(stack, load_mission({**mission_of(trial), "success": list(success)}))
+    body = run.sim.model.body(run.sim.object_bodies[trial.object]).id
+    worst = {"tilt": 0.0, "loose_speed": 0.0}
+
+    def watch() -> None:
+        up = run.sim.data.xmat[body].reshape(3, 3)[2, 2]
+        worst["tilt"] = max(worst["tilt"], math.acos(float(np.clip(up, -1.0, 1.0))))
+        if run.truth.in_hand(trial.object) is None:
+            worst["loose_speed"] = max(worst["loose_speed"], run.truth.object_speed(trial.object))
+
+    run.executor.observers.append(watch)
+    try:
+        return Scenario(run, run.execute()), worst
+    finally:
+        stack.close()
+
+
+# one of each new shape, on each surface, turned away from the hand's natural yaw
+PLACES = {
+    # a bag of chips (40 g, 16 cm tall) turned 29° on the close counter: taken across its 5 cm, kept standing
+    "kettle chips": ("close_counter", (2.40, 3.30), 0.5, (2.22, 2.43, 90.0), (2.70, 3.30)),
+    # the energy bar lying flat (2.2 cm) on the far counter, turned 69°: the pads come down beside it
+    "energy bar": ("far_counter", (7.05, 0.30), 1.2, (6.13, 0.48, 0.0), (7.05, -0.10)),
+    # the sponge (15 g) on the table, turned -40°
+    "sponge": ("table", (2.85, -1.20), -0.7, (1.93, -1.02, 0.0), (2.85, -1.45)),
+    # the apple, a sphere: closed on at its widest, put down without rolling off the spot
+    "apple": ("table", (2.90, -1.45), 0.0, (1.93, -1.27, 0.0), (2.90, -1.15)),
+}
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("name", list(PLACES))
+def test_each_new_shape_is_picked_and_placed_on_the_spot_without_being_knocked_over(kitchen, name):
+    surface, spot, yaw, start, place = PLACES[name]
+    trial = Trial(name, "place", surface, spot, yaw, start, place)
+    scenario, worst = _run(kitchen, trial, success=[{"on": [name, surface]}])
+    assert scenario.result.success, scenario.result.summary()
+    assert scenario.statuses("sequence[0].pick")[-1] == "SUCCESS"
+    x, y, _ = scenario.truth.object_position(name)
+    assert np.hypot(x - place[0], y - place[1]) < 0.03
+    assert scenario.truth.in_hand(name) is None
+    if kitchen.world.objects[name].upright:  # stood upright all along: never pushed askew, never tipped
+        assert worst["tilt"] < math.radians(5.0), f"tilted {math.degrees(worst['tilt']):.1f}°"
+    else:  # lying things stay lying flat
+        assert worst["tilt"] < TILTED, f"tilted {math.degrees(worst['tilt']):.1f}°"
+    assert worst["loose_speed"] < FLUNG, f"out of the hand at {worst['loose_speed']:.2f} m/s: flung"
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize(
+    "name, bin_, surface, spot, start",
+    [
+        ("sponge", "trash_can", "close_counter", (2.90, 3.30), (2.72, 2.43, 90.0)),  # the lightest thing, 15 g
+        ("apple", "compost_bin", "table", (2.85, -1.20), (1.93, -1.02, 0.0)),  # round: it could roll out
+    ],
+)
+def test_throw_away_drops_the_object_into_the_bin_and_the_hand_is_empty(kitchen, name, bin_, surface, spot, start):
+    trial = Trial(name, "throw", surface, spot, 0.3, start, into=bin_)
+    scenario, _ = _run(kitchen, trial, success=[{"inside": [name, bin_]}])
+    assert scenario.result.success, scenario.result.summary()
+    assert scenario.truth.inside(name, bin_) and scenario.truth.in_hand(name) is None
+    believed = scenario.run.context.world_model
+    assert believed.held("right") is None  # the belief's hand is empty too, and the object in the bin
+    (x0, y0), (x1, y1) = kitchen.world.containers[bin_].opening
+    position = next(o for o in believed.objects.values() if o.name == name).position
+    assert x0 <= position[0] <= x1 and y0 <= position[1] <= y1

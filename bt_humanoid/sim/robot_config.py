@@ -44,6 +44,11 @@ class GripperConfig(StrictModel):
     open: float
     closed: float
     grip_site: str
+    open_range: dict[str, tuple[float, float]] = Field(
+        default_factory=dict,
+        description="joint ranges (rad) within which the fingers open fully without meeting the arm; "
+        "the whole-body controller keeps to them while the hand is open",
+    )
 
 
 class CameraConfig(StrictModel):

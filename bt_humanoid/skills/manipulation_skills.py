@@ -17,7 +17,7 @@ from pydantic import Field, model_validator
 from bt_humanoid.control.grasping import LIFT_HEIGHT, PAD_HALF_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
-from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, Limit
+from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.skills.context import CheckContext
@@ -49,6 +49,12 @@ class _ManipulationSkill(PhasedSkill):
         """Keep the base's footprint off a rectangle of the floor ([[x0, y0], [x1, y1]]: furniture reached over)."""
         radius = self.context.robot_config.base.footprint_radius + KEEPOUT_MARGIN
         return BaseKeepoutLimit(self.context.robot_config.frames["base"][1], region, radius)
+
+    def _open_hand(self, side: str) -> list[Limit]:
+        """Limits for a motion with the hand open: its joints within the gripper's open range (the fingers,
+        opened wide, would meet the forearm beyond it and jam)."""
+        ranges = self.context.robot_config.grippers[side].open_range
+        return [JointRangeLimit(ranges)] if ranges else []
 
     def _hand_yaw(self, side: str) -> float:
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
@@ -272,12 +278,19 @@ class Grasp(_ManipulationSkill):
             return None
         self.context.robot.grippers.command(self.params.side, "open")
         target = np.array([hand[0], hand[1], self.grasp.pre_grasp[2]])
-        return whole_body.reach(self.params.side, self._pose(target), move_base=False, tolerance=CARRY_TOLERANCE)
+        return whole_body.reach(
+            self.params.side,
+            self._pose(target),
+            move_base=False,
+            limits=self._open_hand(self.params.side),
+            tolerance=CARRY_TOLERANCE,
+        )
 
     def _pre_grasp(self) -> MotionHandle:
         robot = self.context.robot
         robot.grippers.command(self.params.side, "open")  # opens while the hand travels
         limits = [self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, 0.0)]
+        limits += self._open_hand(self.params.side)
         return robot.whole_body.reach(
             self.params.side, self._pose(self.grasp.pre_grasp), gaze=self.target.position, limits=limits
         )
@@ -288,7 +301,7 @@ class Grasp(_ManipulationSkill):
             self._pose(self.grasp.position),
             speed=DESCEND_SPEED,
             gaze=self.target.position,
-            limits=[self._keepout(self.surface.region)],
+            limits=[self._keepout(self.surface.region), *self._open_hand(self.params.side)],
             tolerance=(0.008, 0.1),
         )
 
@@ -303,17 +316,27 @@ class Grasp(_ManipulationSkill):
                 f"closed {width * 100:.1f} cm wide where the {self.target.name} is {self.grasp.width * 100:.1f} cm: "
                 "not holding it"
             )
-        self.grip_width = width
         self.target.held_by = self.params.side
         self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
 
     def _lift(self) -> MotionHandle:
-        return self.context.robot.whole_body.reach(self.params.side, self._pose(self.grasp.lifted), speed=DESCEND_SPEED)
+        # the base may help a stretched arm up, but not by driving under the surface's edge
+        return self.context.robot.whole_body.reach(
+            self.params.side,
+            self._pose(self.grasp.lifted),
+            speed=DESCEND_SPEED,
+            limits=[self._keepout(self.surface.region)],
+        )
 
     def _verify(self) -> None:
+        """Still held: the pads are held apart by something the object's width.
+
+        Not the width they first stalled at: a light, tall thing pushed askew by the first pad to touch it
+        (a bag of chips) is caught tilted, a centimetre wider, and hangs straight once it is off the surface.
+        """
         grippers = self.context.robot.grippers
         width = grippers.width(self.params.side)
-        if not grippers.holding(self.params.side) or abs(width - self.grip_width) > 0.01:
+        if not grippers.holding(self.params.side) or abs(width - self.grasp.width) > GRASP_WIDTH_TOLERANCE:
             self.target.held_by = None
             self.target.confidence = 0.0  # where it went is unknown until it is seen again
             raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
@@ -479,7 +502,8 @@ class Drop(_ManipulationSkill):
     def _over(self) -> MotionHandle:
         hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
         target = pin.SE3(hand.rotation.copy(), self.release)  # as held: nothing swings
-        limits = [self._keepout(self.footprint), self.walls]
+        # to be let go, the hand must open fully here: within the gripper's open range
+        limits = [self._keepout(self.footprint), self.walls, *self._open_hand(self.params.side)]
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
 
     def _let_go(self) -> MotionHandle:

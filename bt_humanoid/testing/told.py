@@ -18,6 +18,7 @@ from bt_humanoid.language.plan import PlanningContext
 from bt_humanoid.perception.world_model import TrackedObject, WorldModel
 from bt_humanoid.sim.geometry import object_extents, rotation_of
 from bt_humanoid.sim.robot_config import RobotConfig
+from bt_humanoid.sim.scene_config import SceneConfig
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.world_config import WorldConfig
 
@@ -66,14 +67,15 @@ def told_planning_context(world: str = "apartment") -> PlanningContext:
     return PlanningContext(stack.world, stack.context.world_model, np.zeros(3))
 
 
-def told_stack(world: WorldConfig, robot: RobotConfig, seed: int = 0) -> RobotStack:
+def told_stack(world: WorldConfig, robot: RobotConfig, seed: int = 0, scene: SceneConfig | None = None) -> RobotStack:
     """A stack whose robot is told where every object is, its head camera off: control alone.
 
     Nothing a detector sees or misses moves the told objects, skills that look first (find, grasp) recall
     instead, and the navigator plans on the map's furniture alone: for scenes with nothing else on the floor.
+    ``scene``: the objects and start the run has (none: the world's own scene).
     """
     from bt_humanoid.engine.stack import RobotStack
 
-    stack = RobotStack(world, robot.model_copy(update={"cameras": {}}), seed)
+    stack = RobotStack(world, robot.model_copy(update={"cameras": {}}), seed, scene=scene)
     tell_object_poses(stack.context.world_model, stack.sim)
     return stack
