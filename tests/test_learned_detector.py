@@ -60,6 +60,16 @@ def test_crops_are_centred_on_their_region(views: ViewMaker) -> None:
     assert np.all((crop[:3] >= 0.0) & (crop[:3] <= 1.0)) and np.all(np.abs(crop[4]) <= 1.0)
 
 
+def test_views_hold_clutter_the_recogniser_learns_to_call_none(views: ViewMaker) -> None:
+    labels = []
+    for index in range(10):
+        views.arrange(training.view_rng(3, training.TRAIN_STREAM, index))
+        frame, shown = views.capture()
+        labels += [training.region_label(region, shown, views) for region in candidates(frame, views.surfaces)]
+    assert labels.count(NONE) >= 3  # clutter, labelled none
+    assert len(set(labels) - {NONE}) >= 8  # and many of the sixteen
+
+
 def test_the_committed_detector_names_objects_in_views_it_was_not_trained_on(views: ViewMaker) -> None:
     detector = LearnedDetector.for_world(views.sim.world)
     names = list(views.sim.object_bodies)

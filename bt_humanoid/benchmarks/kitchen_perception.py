@@ -5,14 +5,15 @@
 Each scene is a random view (``bt_humanoid/training/views.py``) from the
 benchmark's own seed stream (training and validation use two others): three
 to eight of the sixteen objects on one surface, sometimes a few on another,
-partly hiding one another; the robot 0.4 to 1.7 m from the surface, looking at
+and up to two pieces of clutter (plain shapes in random sizes and colours,
+none of the sixteen), partly hiding one another; the robot 0.4 to 1.7 m from the surface, looking at
 it; the light scaled and turned. The detector runs on the rendered frame, as
 in a run (the robot's own body masked out).
 
 Judged against the simulator: an object counts when its centre is in the
 image, it is within 3 m and more than half of it is visible (its pixels,
 against a render of it alone). A detection matches the nearest object within
-5 cm. Prints recall, precision, identity accuracy (which of the sixteen),
+5 cm; a detection of clutter is a false one. Prints recall, precision, identity accuracy (which of the sixteen),
 median 3-D position error and the detector's time per frame on one core,
 split into the network (crops and inference) and geometry (segmentation and
 poses). ``--json PATH`` also writes the figures.
@@ -89,7 +90,10 @@ def main(argv: list[str] | None = None) -> int:
         counted = {
             i
             for i in used
-            if shares[i] > VISIBLE and np.linalg.norm(centres[i] - eye) < RANGE and _in_image(frame, centres[i])
+            if not maker.instances[i].clutter
+            and shares[i] > VISIBLE
+            and np.linalg.norm(centres[i] - eye) < RANGE
+            and _in_image(frame, centres[i])
         }
         eligible += len(counted)
         detections_total += len(found)
@@ -97,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
         for detection in found:
             distances = {i: float(np.linalg.norm(detection.position - c)) for i, c in centres.items()}
             best = min(distances, key=distances.get) if distances else None
-            if best is None or distances[best] > MATCH_DISTANCE or best in taken:
+            if best is None or distances[best] > MATCH_DISTANCE or best in taken or maker.instances[best].clutter:
                 false_positives += 1
                 misses.append(f"view {index}: a {detection.identity} at {np.round(detection.position, 2)} is not there")
                 continue

@@ -28,6 +28,7 @@ import torch
 from torch import nn
 
 from bt_humanoid.perception.crops import region_crop, region_features
+from bt_humanoid.perception.detector import Region
 from bt_humanoid.perception.learned_detector import candidates
 from bt_humanoid.perception.recogniser import NONE, Recogniser, RecogniserNet
 from bt_humanoid.sim.world_config import load_world_config
@@ -63,7 +64,7 @@ def render_dataset(maker: ViewMaker, classes: list[str], views: int, seed: int, 
         for region in candidates(frame, maker.surfaces):
             crops.append(region_crop(frame, region).astype(np.float16))
             features.append(region_features(region, frame.position))
-            labels.append(index_of[_label(region, shown, maker)])
+            labels.append(index_of[region_label(region, shown, maker)])
         if (index + 1) % max(1, views // 10) == 0:
             elapsed = time.perf_counter() - started
             print(f"  rendered {index + 1}/{views} views, {len(labels)} regions ({elapsed:.0f} s)", flush=True)
@@ -72,16 +73,18 @@ def render_dataset(maker: ViewMaker, classes: list[str], views: int, seed: int, 
     return Dataset(np.stack(crops), np.stack(features).astype(np.float32), np.array(labels, dtype=np.int64))
 
 
-def _label(region, shown: np.ndarray, maker: ViewMaker) -> str:
+def region_label(region: Region, shown: np.ndarray, maker: ViewMaker) -> str:
+    """The object that shows in most of the region's pixels, or none (clutter, furniture, no one object)."""
     instances = shown[region.rows, region.cols]
     instances = instances[instances >= 0]
     if len(instances) == 0:
         return NONE
     values, counts = np.unique(instances, return_counts=True)
     best = int(np.argmax(counts))
-    if counts[best] < OWN_SHARE * len(region.rows):
+    instance = maker.instances[int(values[best])]
+    if counts[best] < OWN_SHARE * len(region.rows) or instance.clutter:
         return NONE
-    return maker.instances[int(values[best])].name
+    return instance.name
 
 
 def train(data: Dataset, classes: list[str], epochs: int, seed: int) -> RecogniserNet:

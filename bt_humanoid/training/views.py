@@ -1,11 +1,13 @@
 """Random views of a world's objects from the robot's head camera: training data and benchmark scenes.
 
-One simulation holds a few of each of the world's objects. Each view puts
-three to eight of them on one surface (sometimes a few more on another),
-close enough to hide one another partly, at random spots and yaws; stands the
-robot at a random distance and angle from that surface, arms in one of its
-postures, looking at a random point on it; and scales and turns the light.
-Nothing is stepped: a view is an initial state, rendered as it is.
+One simulation holds a few of each of the world's objects, and some clutter:
+plain boxes, cylinders and balls that are none of them. Each view puts three
+to eight objects on one surface (sometimes a few more on another) and up to
+two pieces of clutter, in random sizes and colours, close enough to hide one
+another partly, at random spots and yaws; stands the robot at a random
+distance and angle from that surface, arms in one of its postures, looking at
+a random point on it; and scales and turns the light. Nothing is stepped: a
+view is an initial state, rendered as it is.
 
 ``capture()`` gives the frame as the robot sees it (its own body masked out)
 and, for training and judging only, which object each pixel shows.
@@ -26,7 +28,7 @@ from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.scene_config import Placement, SceneConfig
 from bt_humanoid.sim.scene_objects import footprint_radius, surface_tops
 from bt_humanoid.sim.simulation import Simulation
-from bt_humanoid.sim.world_config import WorldConfig, load_world_config
+from bt_humanoid.sim.world_config import ObjectModel, WorldConfig, WorldObject, load_world_config
 
 COPIES = 2  # of each object in the simulation: a view may show two of a kind
 OBJECTS = (3, 8)  # objects on the viewed surface
@@ -36,6 +38,15 @@ BACK_OFF = (0.0, 1.3)  # m behind the surface's stance
 SIDEWAYS = 0.5  # m either side of it
 TURN = 0.35  # rad either side of facing the surface
 POSTURES = ("home", "ready", "tucked")
+CLUTTER = (  # shape and size (m) of each piece of clutter; every view scales and paints them anew
+    ("box", (0.06, 0.06, 0.06)),
+    ("box", (0.1, 0.04, 0.08)),
+    ("cylinder", (0.06, 0.06, 0.1)),
+    ("cylinder", (0.08, 0.08, 0.06)),
+    ("sphere", (0.06, 0.06, 0.06)),
+)
+CLUTTER_SCALE = (0.6, 1.6)  # of each extent
+CLUTTER_COUNT = 2  # at most, per view
 PARKED = 60.0  # m: objects not in the view wait high above the room, apart (specks too small to render)
 
 
@@ -46,6 +57,7 @@ class Instance:
     qpos: int  # address of its free joint
     radius: float  # m: its footprint's circle
     half_height: float  # m: its centre above the surface it stands on
+    clutter: bool = False  # none of the world's objects
 
 
 def _pool(world: WorldConfig, objects: list[str]) -> list[Placement]:
@@ -73,7 +85,14 @@ class ViewMaker:
         self.objects = [name for name, o in config.objects.items() if o.model is not None]
         if not self.objects:
             raise ValueError(f"world '{world}' has no object models to draw views of")
-        scene = SceneConfig(objects=_pool(config, [n for n in self.objects for _ in range(COPIES)]))
+        clutter = {
+            f"clutter {i}": WorldObject(
+                kind="clutter", colour="grey", model=ObjectModel(shape=shape, size=size, mass=0.1)
+            )
+            for i, (shape, size) in enumerate(CLUTTER)
+        }
+        config = config.model_copy(update={"objects": {**config.objects, **clutter}})
+        scene = SceneConfig(objects=_pool(config, [n for n in self.objects for _ in range(COPIES)] + list(clutter)))
         self.sim = sim = Simulation(config, load_robot_config(robot), scene)
         model = sim.model
         model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT  # views are rendered, never stepped
@@ -85,11 +104,10 @@ class ViewMaker:
             obj = config.objects[kind].model
             assert obj is not None
             body = model.body(body_name).id
-            self.instances.append(
-                Instance(
-                    kind, body, int(model.jnt_qposadr[model.body_jntadr[body]]), footprint_radius(obj), obj.size[2] / 2
-                )
-            )
+            address = int(model.jnt_qposadr[model.body_jntadr[body]])
+            radius, half_height = footprint_radius(obj), obj.size[2] / 2
+            self.instances.append(Instance(kind, body, address, radius, half_height, clutter=kind in clutter))
+        self._clutter_sizes = {i: model.geom_size[model.body_geomadr[c.body]].copy() for i, c in self._clutter()}
         camera = next(iter(sim.robot.cameras))
         config_camera = sim.robot.cameras[camera]
         self.camera = RgbdCamera(sim, camera, config_camera.width, config_camera.height)
@@ -112,9 +130,13 @@ class ViewMaker:
         sim, data = self.sim, self.sim.data
         for number, instance in enumerate(self.instances):
             data.qpos[instance.qpos : instance.qpos + 3] = (0.5 * number, 0.0, PARKED)
-        free = list(rng.permutation(len(self.instances)))
+        free = [int(i) for i in rng.permutation(len(self.instances)) if not self.instances[i].clutter]
         surface = self.surfaces[int(rng.integers(len(self.surfaces)))]
         used = self._fill(surface, free, int(rng.integers(OBJECTS[0], OBJECTS[1] + 1)), rng)
+        clutter = [index for index, _ in self._clutter()]
+        for index in clutter:
+            self._reshape(index, rng)
+        used += self._fill(surface, list(rng.permutation(clutter)), int(rng.integers(CLUTTER_COUNT + 1)), rng)
         if rng.random() < 0.5:  # something on another surface too, seen from afar
             other = self.surfaces[int(rng.integers(len(self.surfaces)))]
             if other is not surface:
@@ -133,6 +155,26 @@ class ViewMaker:
         frame.hide((geoms >= 0) & self._robot_geoms[np.maximum(geoms, 0)])
         shown = np.where(geoms >= 0, self._instance_of_geom[np.maximum(geoms, 0)], -1)
         return frame, shown
+
+    def _clutter(self) -> list[tuple[int, Instance]]:
+        return [(index, instance) for index, instance in enumerate(self.instances) if instance.clutter]
+
+    def _reshape(self, index: int, rng: np.random.Generator) -> None:
+        """A piece of clutter in a new size and colour (for rendering: views are never stepped)."""
+        model, instance = self.sim.model, self.instances[index]
+        geom = model.body_geomadr[instance.body]
+        size = self._clutter_sizes[index] * rng.uniform(*CLUTTER_SCALE, size=3)
+        kind = model.geom_type[geom]
+        if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+            size[:] = size[0]
+            instance.radius, instance.half_height = float(size[0]), float(size[0])
+        elif kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            instance.radius, instance.half_height = float(size[0]), float(size[1])
+        else:
+            instance.radius, instance.half_height = float(np.hypot(size[0], size[1])), float(size[2])
+        model.geom_size[geom] = size
+        model.geom_rgba[geom] = (*rng.uniform(0.05, 0.95, size=3), 1.0)
+        model.geom_matid[geom] = -1  # its own colour, not a material's
 
     def _fill(self, surface, free: list[int], count: int, rng: np.random.Generator) -> list[int]:
         """Stand up to ``count`` of the free instances on ``surface`` at random spots; returns those placed."""
