@@ -29,8 +29,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from bt_humanoid.errors import UserError
 from bt_humanoid.language.audio import RATE, with_noise
-from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, write_dictionary
+from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH, known_words, write_dictionary
 from bt_humanoid.language.vocabulary import INTENTS, SAY_PHRASES, WorldVocabulary
 from bt_humanoid.language.words import AFTER, POLITE_SPOKEN, UNCLEAR, WAKE_WORDS, is_unclear
 from bt_humanoid.sim.world_config import WorldConfig
@@ -96,13 +97,15 @@ def command_grammar(world: WorldConfig) -> str:
     """A JSGF grammar of the commands the embedded planner understands, in this world's words.
 
     Its verbs are the spoken verbs of ``vocabulary.INTENTS`` (the planner's phrasings are built from the same
-    table), its names every name and alias world.yaml gives an object, place or surface.
+    table), its names every name and alias world.yaml gives an object, place or surface that the recogniser
+    can hear: plain English words of its dictionary ("coca-cola", "7up" and "rxbar" are typed; "coca cola" and
+    "seven up" are said). A thing with no name it can hear is an error naming it.
     """
     words = WorldVocabulary.of(world)
-    names = sorted(words.objects)
+    names = _audible(words.objects, "object", world)
     home = {w for w, place in words.places.items() if place == "start"}  # "go home" says it
-    places = sorted(set(words.places) - home)
-    surfaces = sorted(words.surfaces)
+    places = sorted(set(_audible(words.places, "place", world)) - home)
+    surfaces = _audible(words.surfaces, "surface", world)
     unmovable = sorted({"person", *places, *surfaces})
     rule = " | ".join
     verbs = {name: intent.rule() for name, intent in INTENTS.items() if intent.spoken}
@@ -149,6 +152,20 @@ def command_grammar(world: WorldConfig) -> str:
             "",
         ]
     )
+
+
+def _audible(names: dict[str, str], what: str, world: WorldConfig) -> list[str]:
+    """The names (words → thing) made of words the recogniser knows; every thing must keep one."""
+    known = known_words()
+    audible = sorted(n for n in names if all(re.fullmatch(r"[a-z']+", w) and w in known for w in n.split()))
+    unheard = sorted(set(names.values()) - {names[n] for n in audible})
+    if unheard:
+        raise UserError(
+            f"the recogniser cannot hear any name of the {what} {', '.join(repr(u) for u in unheard)}",
+            where=f"worlds/{world.name}/world.yaml",
+            hint="give it an alias of English words (aliases: [...]), as 'seven up' for 7up",
+        )
+    return audible
 
 
 def frame_power(samples: np.ndarray, frame: float = 0.01) -> np.ndarray:

@@ -13,6 +13,7 @@ CMUdict's 130,000.
 from __future__ import annotations
 
 import re
+from functools import lru_cache
 from pathlib import Path
 
 from bt_humanoid.errors import UserError
@@ -57,6 +58,12 @@ def grammar_words(grammar: str) -> list[str]:
     body = "\n".join(line for line in grammar.splitlines() if not line.startswith(("#JSGF", "grammar ")))
     body = re.sub(r"<[^>]*>|//.*|/[0-9.]+/|\bpublic\b", " ", body)
     return sorted(set(re.findall(r"[a-z'_]+", body)))
+
+
+@lru_cache(maxsize=1)
+def known_words() -> frozenset[str]:
+    """Every word of pocketsphinx's dictionary: the words a grammar may use."""
+    return frozenset(read_cmudict())
 
 
 def read_cmudict(path: Path | None = None) -> dict[str, list[str]]:
