@@ -122,10 +122,11 @@ def _sentences(grammar: str, folder, count: int, seed: int = 0) -> list[str]:
     return sorted(sentences)
 
 
-def test_every_command_the_grammar_hears_is_one_the_planner_understands(tmp_path):
+@pytest.mark.parametrize("world", ["apartment", "kitchen"])
+def test_every_command_the_grammar_hears_is_one_the_planner_understands(tmp_path, world):
     # "I can't …" is the planner's answer to words it has no phrasing for; any other answer (a plan, a question,
     # a refusal with a reason such as "I can't pick up people") means it understood what was asked.
-    context = told_planning_context("apartment")
+    context = told_planning_context(world)
     planner = EmbeddedPlanner()
     not_understood = {}
     for sentence in _sentences(command_grammar(context.world), tmp_path, 300):

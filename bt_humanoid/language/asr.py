@@ -106,6 +106,7 @@ def command_grammar(world: WorldConfig) -> str:
     home = {w for w, place in words.places.items() if place == "start"}  # "go home" says it
     places = sorted(set(_audible(words.places, "place", world)) - home)
     surfaces = _audible(words.surfaces, "surface", world)
+    containers = _audible(words.containers, "bin", world)
     unmovable = sorted({"person", *places, *surfaces})
     rule = " | ".join
     verbs = {name: intent.rule() for name, intent in INTENTS.items() if intent.spoken}
@@ -122,7 +123,7 @@ def command_grammar(world: WorldConfig) -> str:
             "<command> = <clause> [<next>];",
             "<next> = (and | then | and then) <clause> [<next>];",
             "<clause> = <take> | <put> | <bring> | <go> | <step> | <turn> | <find> | <wave> | <stop> | <say>"
-            " | <unclear>;",
+            f"{' | <throw>' if containers else ''} | <unclear>;",
             f"<take> = {verbs['take']} (<object> | the <unmovable>) | pick <object> up;",
             f"<put> = {verbs['put']} <thing> [down] (on | onto) <surface>"
             f" | {verbs['carry_to_surface']} <thing> [over] to <surface>;",
@@ -131,6 +132,15 @@ def command_grammar(world: WorldConfig) -> str:
             f"<step> = {verbs['step']} (forward | back | backward) [<number> (meters | meter)];",
             f"<turn> = {verbs['turn']} (left | right) [<number> degrees] | turn around | {verbs['face']} <place>;",
             f"<find> = {verbs['find']} <object>;",
+            *(
+                [
+                    f"<throw> = {verbs['throw_away']} <thing> | throw <thing> (away | out)"
+                    f" | {verbs['put']} <thing> (in | into) <container>;",
+                    f"<container> = the ({rule(containers)});",
+                ]
+                if containers
+                else []
+            ),
             f"<wave> = {verbs['wave']} [<number> times];",
             f"<stop> = {verbs['stop']};",
             f"<say> = {verbs['say']} ({rule(SAY_PHRASES)});",

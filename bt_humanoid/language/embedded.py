@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
-from bt_humanoid.language.vocabulary import INTENTS, WorldVocabulary, every_verb
+from bt_humanoid.language.vocabulary import BIN_VERBS, INTENTS, WorldVocabulary, every_verb
 from bt_humanoid.language.words import normalise
 from bt_humanoid.perception.free_space import free_spot
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS, describes_an_object, ground
@@ -96,6 +96,8 @@ PATTERNS: list[tuple[str, re.Pattern[str]]] = [
         ),
     ),
     ("bring_me", re.compile(rf"^{_verbs('bring_here')}\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
+    ("throw_away", re.compile(r"^(?:throw|toss|chuck)\s+(?P<what>.+?)\s+(?:away|out)$")),  # "throw the can away"
+    ("throw_away", re.compile(rf"^(?P<verb>{_verbs('throw_away')})\s+(?P<what>.+)$")),
     (
         "put",
         re.compile(
@@ -254,6 +256,11 @@ class EmbeddedPlanner:
     def _put(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         self._put_on(match["what"], match["where"], state, context)
 
+    def _throw_away(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        takes = BIN_VERBS.get(match.groupdict().get("verb") or "")  # "recycle": a bin for recyclable things
+        for target in self._objects(match["what"], state, context):
+            self._into(target, _bin_for(target, takes, context), state, context)
+
     def _put_down(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         surfaces = ", the ".join(context.world.surfaces)
         raise PlanRefused(f"Where should I put it? Say, for example, 'put it on the {surfaces}'.")
@@ -325,8 +332,26 @@ class EmbeddedPlanner:
         state.steps.append({"navigate": {"person": person}})
         state.lines.append("come to you")
 
+    def _into(self, target: str, container: str, state: _State, context: PlanningContext) -> None:
+        """Drop ``target`` into an open bin: carry it there if it is in hand, else take it first."""
+        if state.held == target:
+            state.steps.append({"navigate": {"place": context.world.containers[container].place}})
+            state.steps.append({"drop": {"into": container}})
+        else:
+            if state.held is not None:
+                raise PlanRefused(f"I will be holding the {state.held}; I can carry one thing at a time.")
+            state.steps.append({"throw_away": {"object": target, "into": container}})
+        state.lines.append(f"put the {target} in the {_spoken(container)}")
+        state.held = None
+        state.last = [target]
+
     def _put_on(self, what: str, where: str, state: _State, context: PlanningContext) -> None:
         words = _bare(where)
+        container = WorldVocabulary.of(context.world).container(words)
+        if container is not None:  # "put the apple in the compost"
+            for target in self._objects(what, state, context):
+                self._into(target, container, state, context)
+            return
         surface_name = WorldVocabulary.of(context.world).surface(words) or words
         if surface_name not in context.world.surfaces:
             surfaces = ", the ".join(context.world.surfaces)
@@ -558,6 +583,29 @@ def _by_vocabulary(words: str, context: PlanningContext) -> list[str]:
                 continue
             fitting.append(name)
     return fitting
+
+
+def _bin_for(target: str, takes: str | None, context: PlanningContext) -> str:
+    """The bin for ``target``: one for ``takes`` things (recycle, compost), else the most particular bin its
+    categories suit (a can is recyclable), else one that takes anything (the trash)."""
+    containers = context.world.containers
+    if not containers:
+        raise PlanRefused("There is no bin here to put things in.")
+    kind = context.world.object_of(target)
+    categories = set(context.world.objects[kind].categories) if kind is not None else set()
+    if takes is not None:
+        bins = [name for name, c in containers.items() if takes in c.takes]
+        if not bins:
+            raise PlanRefused(f"There is no bin for {takes} things here.")
+        if kind is not None and takes not in categories:
+            other = _bin_for(target, None, context)
+            raise PlanRefused(f"The {target} is not {takes}; say 'throw away the {target}' for the {_spoken(other)}.")
+        return bins[0]
+    suited = [name for name, c in containers.items() if c.takes and categories & set(c.takes)]
+    anything = [name for name, c in containers.items() if not c.takes]
+    if not suited and not anything:
+        raise PlanRefused(f"None of the bins here takes the {target}.")
+    return (suited or anything)[0]
 
 
 def _which(options: list[str]) -> str:

@@ -81,7 +81,15 @@ INTENTS: dict[str, Intent] = {
         ("find", "say"),
     ),
     "take": Intent(("pick up", "grab", "take", "get", "lift", "collect"), ("pick", "grasp", "hold"), ("take",)),
+    # "throw away the coke", "recycle the can", "compost the apple": into the bin that takes it
+    "throw_away": Intent(
+        ("throw away", "throw out", "recycle", "compost"),
+        ("dispose of", "get rid of", "discard", "bin", "trash", "toss", "chuck"),
+        ("throw_away", "navigate", "drop"),
+    ),
 }
+# the bin a verb of throw_away asks for, by what the bin takes (world.yaml containers' takes:)
+BIN_VERBS = {"recycle": "recyclable", "compost": "compostable"}
 SAY_PHRASES = ("hello", "hello everyone", "goodbye", "done", "thank you")  # what "say …" is heard as when spoken
 
 
@@ -110,6 +118,7 @@ class WorldVocabulary:
     objects: dict[str, str]  # words → object name ("tea caddy" → "tea tin"; a name is its own words)
     places: dict[str, str]  # words → place name ("living room" → "living_room", "dining table" → "table")
     surfaces: dict[str, str]  # words → surface name
+    containers: dict[str, str]  # words → open bin ("trash" → "trash_can")
     people: list[str]  # every name a person answers to
     kinds: list[str]  # words for kinds of things (singular): cube, block, mug, …
     plurals: list[str]  # and their plurals: cubes, mugs, …
@@ -121,11 +130,14 @@ class WorldVocabulary:
         places = {spoken(n): n for n in world.places} | {a: n for n, p in world.places.items() for a in p.aliases}
         surfaces = {spoken(n): n for n in world.surfaces}
         surfaces |= {a: n for n, s in world.surfaces.items() for a in s.aliases}
+        containers = {spoken(n): n for n in world.containers}
+        containers |= {a: n for n, c in world.containers.items() for a in c.aliases}
         declared_kinds = {o.kind for o in world.objects.values()}
         kinds = {w for w in KIND_WORDS if not w.endswith("s")} | {k for k in declared_kinds if k not in KIND_WORDS}
         plurals = {w for w in KIND_WORDS if w.endswith("s") and w[:-1] in KIND_WORDS}
         colours = (COLOURS - {"gray"}) | {o.colour for o in world.objects.values()}
-        return cls(objects, places, surfaces, world.person_names, sorted(kinds), sorted(plurals), sorted(colours))
+        people = world.person_names
+        return cls(objects, places, surfaces, containers, people, sorted(kinds), sorted(plurals), sorted(colours))
 
     def place(self, words: str) -> str | None:
         """The place some words name ("the" already gone), or None."""
@@ -133,6 +145,9 @@ class WorldVocabulary:
 
     def surface(self, words: str) -> str | None:
         return self.surfaces.get(words) or self.surfaces.get(spoken(words))
+
+    def container(self, words: str) -> str | None:
+        return self.containers.get(words) or self.containers.get(spoken(words))
 
     def object(self, words: str) -> str | None:
         """The object a name or an alias names exactly, or None (descriptions are for grounding)."""

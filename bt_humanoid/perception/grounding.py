@@ -140,6 +140,8 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
         kind, colour = belief.vocabulary[named]
         kinds.add(kind)
         colours.add(colour)
+    # a name perception recognises by look ("pepsi", not "a blue can": a red bull is one too)
+    by_identity = named is not None and any(o.identity is not None for o in present)
     attributes = bool(colours or kinds or surface or room or anchor is not None)
     scores = []
     for tracked in present:
@@ -156,6 +158,8 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
             score += 1.0 if belief.room_of(tracked.position) == room else -2.0
         if anchor is not None:
             score += 1.0 if wanted in pairwise(tracked, anchor, viewer) else -2.0
+        if by_identity:
+            score += 1.0 if tracked.identity == named else -2.0
         scores.append(score)
     scores = np.array(scores)
     if leftover and use_embeddings and not attributes:
@@ -169,6 +173,7 @@ def ground(phrase: str, belief: WorldModel, viewer: np.ndarray | None = None, us
     elif leftover and not attributes:
         return _not_found(phrase, present)  # nothing to go on without embeddings
     needed = (len(colours) > 0) + (len(kinds) > 0) + (surface is not None) + (room is not None) + (anchor is not None)
+    needed += by_identity
     if attributes and scores.max() < needed - 0.7:
         return _not_found(phrase, present)
     if biggest or smallest:
