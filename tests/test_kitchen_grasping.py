@@ -8,7 +8,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from bt_humanoid.benchmarks.kitchen_manipulation import Kitchen, Trial, mission_of, scene_of
+from bt_humanoid.benchmarks.kitchen_manipulation import Kitchen, Outcome, Trial, mission_of, scene_of, summarize, table
+from bt_humanoid.cli import validate_main
 from bt_humanoid.control.grasping import (
     OPENING_MARGIN,
     PAD_HALF_HEIGHT,
@@ -17,7 +18,7 @@ from bt_humanoid.control.grasping import (
     hand_yaws,
     plan_grasp,
 )
-from bt_humanoid.control.wbc.limits import JointRangeLimit
+from bt_humanoid.control.wbc.limits import BaseBoundsLimit, JointRangeLimit
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.perception.world_model import TrackedObject
 from bt_humanoid.sim.simulation import Simulation
@@ -169,6 +170,22 @@ def test_a_joint_range_limit_holds_a_joint_inside_and_brings_one_outside_back():
     assert np.all(outside.G @ np.array([0.0, -0.001]) >= outside.lower)  # coming back in is
 
 
+def test_a_bounds_limit_keeps_the_base_off_the_walls():
+    base = SimpleNamespace(translation=np.array([7.1, 0.0, 0.0]))
+    jacobian = np.zeros((6, 3))
+    jacobian[0, 0] = jacobian[1, 1] = 1.0  # the base's x and y joints move it straight
+    kinematics = SimpleNamespace(joints=["x", "y", "yaw"], pose=lambda _: base, jacobian=lambda _: jacobian)
+    limit = BaseBoundsLimit("base", np.array([[-1.5, -3.5], [7.5, 3.8]]), radius=0.35)
+    near = limit.inequality(kinematics, 0.01)  # 0.4 m from the east wall: only it is near enough to count
+    assert len(near.lower) == 1
+    assert np.all(near.G @ np.array([0.02, 0.0, 0.0]) >= near.lower)  # half the 5 cm of slack may go
+    assert not np.all(near.G @ np.array([0.03, 0.0, 0.0]) >= near.lower)
+    base.translation = np.array([7.2, 0.0, 0.0])  # 0.3 m: too close, it must move away
+    close = limit.inequality(kinematics, 0.01)
+    assert not np.all(close.G @ np.zeros(3) >= close.lower)
+    assert np.all(close.G @ np.array([-0.001, 0.0, 0.0]) >= close.lower)
+
+
 # --------------------------------------------------------------------------- on real physics, told where things are
 
 TILTED = math.radians(15.0)  # what counts as knocked over
@@ -250,3 +267,44 @@ def test_throw_away_drops_the_object_into_the_bin_and_the_hand_is_empty(kitchen,
     (x0, y0), (x1, y1) = kitchen.world.containers[bin_].opening
     position = next(o for o in believed.objects.values() if o.name == name).position
     assert x0 <= position[0] <= x1 and y0 <= position[1] <= y1
+
+
+# --------------------------------------------------------------------------- drop and inside: checked before running
+
+
+def _validate(tmp_path, capsys, text: str) -> tuple[int, str]:
+    path = tmp_path / "m.yaml"
+    path.write_text(text)
+    code = validate_main([str(path)])
+    return code, capsys.readouterr().err.strip()
+
+
+def test_a_drop_into_something_that_is_no_bin_is_refused_naming_the_bins(tmp_path, capsys):
+    text = "mission: x\nworld: kitchen\ntree:\n  sequence:\n    - pick: {object: coke}\n    - drop: {into: fridge}\n"
+    code, err = _validate(tmp_path, capsys, text)
+    assert code == 2
+    assert "m.yaml:6" in err and "unknown container 'fridge'" in err
+    assert "trash_can" in err and "recycling_bin" in err and "compost_bin" in err
+
+
+def test_an_inside_condition_names_an_object_of_the_run_and_a_bin(tmp_path, capsys):
+    head = "mission: x\nworld: kitchen\ntree: {throw_away: {object: coke, into: trash_can}}\nsuccess:\n"
+    assert _validate(tmp_path, capsys, head + "  - inside: [coke, trash_can]\n")[0] == 0
+    code, err = _validate(tmp_path, capsys, head + "  - inside: [coke, table]\n")
+    assert code == 2 and "m.yaml:5" in err and "unknown name 'table'" in err
+
+
+def test_the_kitchen_table_says_what_each_rate_is_counted_over():
+    place = Trial("coke", "place", "table", (2.9, -1.2), 0.0, (1.9, -1.0, 0.0), (2.9, -1.4))
+    throw = Trial("coke", "throw", "table", (2.9, -1.2), 0.0, (1.9, -1.0, 0.0))
+
+    def outcome(grasped: bool, done: bool) -> Outcome:
+        return Outcome(grasped, done, 0.4 if done else None, None if done else "missed", 20.0)
+
+    trials = [place] * 4 + [throw] * 2
+    outcomes = [outcome(True, True)] * 2 + [outcome(True, False), outcome(False, False)]
+    outcomes += [outcome(True, True), outcome(True, False)]
+    header, row, total = table([summarize("coke", trials, outcomes)]).splitlines()
+    assert "grasp | of all" in header and "place | of grasped" in header and "into bin | of all" in header
+    assert "5/6 83%" in row and "2/3 67%" in row and "2/4 50%" in row and "1/2 50%" in row
+    assert total.split()[0] == "all"

@@ -17,7 +17,7 @@ from pydantic import Field, model_validator
 from bt_humanoid.control.grasping import LIFT_HEIGHT, PAD_HALF_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
-from bt_humanoid.control.wbc.limits import BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
+from bt_humanoid.control.wbc.limits import BaseBoundsLimit, BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.skills.context import CheckContext
@@ -45,10 +45,13 @@ BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its lin
 class _ManipulationSkill(PhasedSkill):
     """Shared helpers: reach limits, the carry pose."""
 
-    def _keepout(self, region: np.ndarray) -> Limit:
-        """Keep the base's footprint off a rectangle of the floor ([[x0, y0], [x1, y1]]: furniture reached over)."""
+    def _keepout(self, region: np.ndarray) -> list[Limit]:
+        """Keep the base's footprint off a rectangle of the floor ([[x0, y0], [x1, y1]]: furniture reached over)
+        and off the map's walls, while it helps a reach."""
         radius = self.context.robot_config.base.footprint_radius + KEEPOUT_MARGIN
-        return BaseKeepoutLimit(self.context.robot_config.frames["base"][1], region, radius)
+        base = self.context.robot_config.frames["base"][1]
+        walls = BaseBoundsLimit(base, np.array(self.context.world.bounds), radius)
+        return [BaseKeepoutLimit(base, region, radius), walls]
 
     def _open_hand(self, side: str) -> list[Limit]:
         """Limits for a motion with the hand open: its joints within the gripper's open range (the fingers,
@@ -289,7 +292,7 @@ class Grasp(_ManipulationSkill):
     def _pre_grasp(self) -> MotionHandle:
         robot = self.context.robot
         robot.grippers.command(self.params.side, "open")  # opens while the hand travels
-        limits = [self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, 0.0)]
+        limits = [*self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, 0.0)]
         limits += self._open_hand(self.params.side)
         return robot.whole_body.reach(
             self.params.side, self._pose(self.grasp.pre_grasp), gaze=self.target.position, limits=limits
@@ -301,7 +304,7 @@ class Grasp(_ManipulationSkill):
             self._pose(self.grasp.position),
             speed=DESCEND_SPEED,
             gaze=self.target.position,
-            limits=[self._keepout(self.surface.region), *self._open_hand(self.params.side)],
+            limits=[*self._keepout(self.surface.region), *self._open_hand(self.params.side)],
             tolerance=(0.008, 0.1),
         )
 
@@ -325,7 +328,7 @@ class Grasp(_ManipulationSkill):
             self.params.side,
             self._pose(self.grasp.lifted),
             speed=DESCEND_SPEED,
-            limits=[self._keepout(self.surface.region)],
+            limits=self._keepout(self.surface.region),
         )
 
     def _verify(self) -> None:
@@ -409,7 +412,7 @@ class Put(_ManipulationSkill):
         return np.clip(hand_xy, region[0] + 0.12, region[1] - 0.12)
 
     def _above(self) -> MotionHandle:
-        limits = [self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, self.below_hand)]
+        limits = [*self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, self.below_hand)]
         target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, APPROACH_CLEARANCE + 0.02]))
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
 
@@ -420,7 +423,7 @@ class Put(_ManipulationSkill):
             target,
             speed=DESCEND_SPEED / 2,
             gaze=self.release,
-            limits=[self._keepout(self.surface.region)],
+            limits=self._keepout(self.surface.region),
             stop_on_contact=True,
         )
 
@@ -503,7 +506,7 @@ class Drop(_ManipulationSkill):
         hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
         target = pin.SE3(hand.rotation.copy(), self.release)  # as held: nothing swings
         # to be let go, the hand must open fully here: within the gripper's open range
-        limits = [self._keepout(self.footprint), self.walls, *self._open_hand(self.params.side)]
+        limits = [*self._keepout(self.footprint), self.walls, *self._open_hand(self.params.side)]
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
 
     def _let_go(self) -> MotionHandle:
