@@ -64,11 +64,17 @@ class DetectorTimes:
 
 
 def candidates(frame: RgbdFrame, surfaces: list[SupportSurface]) -> list[Region]:
-    """Regions worth judging: resting on their surface (not held above it) and wider than a sliver."""
+    """Regions worth judging: resting on their surface (not held above it) and wider than a sliver.
+
+    A region whose foot is out of sight (below the image's edge, or behind the robot's own arm) may rest on
+    the surface all the same: it is judged too.
+    """
     kept = []
+    bottom_row = frame.depth.shape[0] - 1
     for region in segment(frame, surfaces):
         heights = region.points[:, 2] - region.surface.height
-        if heights.min() > RESTING or np.count_nonzero(heights > heights.max() - TOP_BAND) < 5:
+        foot_hidden = region.occluded or int(region.rows.max()) >= bottom_row
+        if (heights.min() > RESTING and not foot_hidden) or np.count_nonzero(heights > heights.max() - TOP_BAND) < 5:
             continue
         if region_features(region, frame.position)[1] < MIN_WIDTH:
             continue
