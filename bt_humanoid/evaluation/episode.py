@@ -168,8 +168,11 @@ def _random_scene(suite: Suite, draw: Draw, probe: RobotStack, base: SceneConfig
     fewest, most = settings.objects
     count = int(rng.integers(fewest, most + 1))
     among = settings.among or world.placeable
+    # the episode's object is the only one of its kind: "put the coke on the counter" names one thing, and its
+    # verdict judges that one (a second coke might stand there from the start)
+    others = [name for name in among if name != draw.obj] or among
     chosen = [draw.obj] if draw.obj else []
-    chosen += [str(name) for name in rng.choice(among, size=count - len(chosen))] if count > len(chosen) else []
+    chosen += [str(name) for name in rng.choice(others, size=count - len(chosen))] if count > len(chosen) else []
     placements: list[Placement] = []
     taken: list[np.ndarray] = []
     for index, name in enumerate(chosen):

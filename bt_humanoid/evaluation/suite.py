@@ -53,7 +53,8 @@ class SceneDraw(StrictModel):
     surfaces: list[str] = Field(min_length=1, description="surfaces they stand on, at random spots the hand reaches")
     among: list[str] = Field(
         default_factory=list,
-        description='objects to draw from, as many of each as drawn ("coke", "coke 2"); none: every one scenes place',
+        description='objects to draw from, as many of each as drawn ("coke", "coke 2"), the episode\'s {object} '
+        "once only; none: every one scenes place",
     )
 
     @model_validator(mode="after")
