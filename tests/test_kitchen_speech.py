@@ -7,6 +7,7 @@ from bt_humanoid.language.asr import CommandRecognizer, command_grammar
 from bt_humanoid.language.audio import spoken
 from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.testing.grammar import not_understood
 from bt_humanoid.testing.told import told_planning_context
 
 
@@ -76,3 +77,7 @@ def test_a_spoken_throw_away_is_heard_and_planned(kitchen):
     heard = recognizer.transcribe(spoken("hey robot, throw away the seven up"))
     assert heard.command == "throw away the seven up", heard.text
     assert EmbeddedPlanner().plan(heard.command, kitchen).kind == "mission"
+
+
+def test_every_kitchen_command_the_grammar_hears_is_one_the_planner_understands(kitchen, tmp_path):
+    assert not_understood(kitchen, tmp_path) == {}

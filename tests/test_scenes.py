@@ -17,7 +17,6 @@ from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation import episode
 from bt_humanoid.evaluation.episode import Draw, _random_scene
-from bt_humanoid.evaluation.scenes import EDGE_MARGIN
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.sim.ground_truth import GroundTruth
@@ -26,6 +25,7 @@ from bt_humanoid.sim.scene_config import Holding, Placement, SceneConfig, load_s
 from bt_humanoid.sim.scene_objects import body_name
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.testing.spots import EDGE_MARGIN
 
 
 @pytest.fixture(scope="module")

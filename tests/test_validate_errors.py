@@ -263,7 +263,7 @@ def test_unknown_success_condition(tmp_path, capsys):
         """,
     )
     code, err = validate(capsys, path)
-    assert code == 2 and "m.yaml:6" in err and "unknown condition 'under'" in err and "valid: on, at" in err
+    assert code == 2 and "m.yaml:6" in err and "unknown condition 'under'" in err and "valid: on, inside, at" in err
 
 
 def test_missing_file(tmp_path, capsys):

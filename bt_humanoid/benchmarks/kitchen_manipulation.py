@@ -6,7 +6,7 @@ thrown away into the trash can.
 Control alone: the robot is told where the object is and its head camera is off (``testing/told.py``), so
 the figures do not move with the detector. Each trial has the object in play alone in the kitchen, standing
 (or lying) at a random spot and yaw that the right hand reaches from every free stance beside it
-(``evaluation/scenes.py``), and the robot starts 0.3 m behind one of those stances, drawn at random.
+(``testing/spots.py``), and the robot starts 0.3 m behind one of those stances, drawn at random.
 Pick-and-place trials take the surfaces in turn (table, close counter, far counter) and run the `pick` and
 `place` behaviours to another such spot on the same surface; throw-away trials start the same way and run
 the `throw_away` behaviour into the trash can. Judged in ground truth: a grasp when a pick ends with the
@@ -28,12 +28,12 @@ import numpy as np
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
 from bt_humanoid.control.stance import stance_for
 from bt_humanoid.engine.runner import MissionRun
-from bt_humanoid.evaluation.scenes import STANCE_ROOM, reachable_spot
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
 from bt_humanoid.sim.scene_config import Placement, SceneConfig
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.testing.scenario import load_mission
+from bt_humanoid.testing.spots import STANCE_ROOM, reachable_spot
 from bt_humanoid.testing.told import told_stack
 
 WORLD = "kitchen"

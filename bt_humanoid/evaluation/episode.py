@@ -26,12 +26,12 @@ from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.engine.verdict import check_condition
 from bt_humanoid.evaluation import faults as fault_kinds
-from bt_humanoid.evaluation.scenes import nudge, reachable_spot
 from bt_humanoid.evaluation.suite import Suite, Task, fill, load_suite, suite_scene
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.schema import MissionHeader, OnCondition, UprightCondition
 from bt_humanoid.sim.scene_config import Placement, SceneConfig
 from bt_humanoid.testing.scene import place_object
+from bt_humanoid.testing.spots import nudge, reachable_spot
 
 
 @cache

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import random
 from dataclasses import dataclass
 from pathlib import Path
 
 from pocketsphinx import Jsgf, LogMath
+
+from bt_humanoid.language.asr import command_grammar
+from bt_humanoid.language.embedded import EmbeddedPlanner
+from bt_humanoid.language.plan import PlanningContext
+from bt_humanoid.language.pronunciation import UNCLEAR_SPEECH
 
 
 @dataclass
@@ -30,3 +36,32 @@ def finite_state_grammar(grammar: str, folder: Path) -> FiniteStateGrammar:
         elif fields[:1] == ["TRANSITION"]:
             fsg.arcs.setdefault(int(fields[1]), []).append((int(fields[2]), fields[4] if len(fields) > 4 else None))
     return fsg
+
+
+def grammar_sentences(grammar: str, folder: Path, count: int, seed: int = 0) -> list[str]:
+    """Random commands the grammar accepts (walks through its finite-state form), without unclear speech."""
+    fsg = finite_state_grammar(grammar, folder)
+    start, final, arcs = fsg.start, fsg.final, fsg.arcs
+    rng = random.Random(seed)
+    sentences: set[str] = set()
+    while len(sentences) < count:
+        state, words = start, []
+        while state != final and len(words) < 30:
+            state, word = rng.choice(arcs[state])
+            words += [word] if word else []
+        if state == final and UNCLEAR_SPEECH not in words:
+            sentences.add(" ".join(words))
+    return sorted(sentences)
+
+
+def not_understood(context: PlanningContext, folder: Path) -> dict[str, str]:
+    """Random sentences of the world's speech grammar that its planner has no phrasing for, with its answers."""
+    planner = EmbeddedPlanner()
+    # "I can't …" is the planner's answer to words it has no phrasing for; any other answer (a plan, a question,
+    # a refusal with a reason such as "I can't pick up people") means it understood what was asked
+    refused = {}
+    for sentence in grammar_sentences(command_grammar(context.world), folder, 300):
+        plan = planner.plan(sentence, context)
+        if plan.kind == "refusal" and plan.say.startswith("I can't") and "I can go to a place" in plan.say:
+            refused[sentence] = plan.say
+    return refused

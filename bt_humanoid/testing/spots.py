@@ -1,4 +1,4 @@
-"""Random scenes for evaluation: where an object stands, where the robot starts, how furniture is nudged.
+"""Random spots for set-up: where an object stands that the hand reaches, how furniture is nudged.
 
 Everything here is set-up, done before the first simulation step; what it
 draws comes from one numpy Generator, so an episode's scene follows from its
