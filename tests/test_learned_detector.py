@@ -109,3 +109,12 @@ def test_the_kitchen_robot_recognises_the_coke_among_other_cans() -> None:
         assert {"pepsi", "7up"} <= seen
     finally:
         stack.close()
+
+
+def test_a_frame_says_which_points_project_into_it(views: ViewMaker) -> None:
+    views.arrange(training.view_rng(7, training.BENCHMARK_STREAM, 1))
+    frame, _ = views.capture()
+    ahead = frame.position - frame.rotation[:, 2]  # one metre along the line of sight (the camera looks along -z)
+    assert frame.in_image(ahead)
+    assert not frame.in_image(frame.position + frame.rotation[:, 2])  # behind the camera
+    assert not frame.in_image(ahead + 5.0 * frame.rotation[:, 0])  # far off to the right

@@ -93,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
             if not maker.instances[i].clutter
             and shares[i] > VISIBLE
             and np.linalg.norm(centres[i] - eye) < RANGE
-            and _in_image(frame, centres[i])
+            and frame.in_image(centres[i])
         }
         eligible += len(counted)
         detections_total += len(found)
@@ -148,16 +148,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"    {miss}")
     save_figures(args.json, figures)
     return 0
-
-
-def _in_image(frame, point: np.ndarray) -> bool:
-    local = frame.rotation.T @ (point - frame.position)
-    if local[2] >= 0:
-        return False
-    u = frame.centre[0] + frame.focal * local[0] / -local[2]
-    v = frame.centre[1] - frame.focal * local[1] / -local[2]
-    height, width = frame.depth.shape
-    return bool(0 <= u < width and 0 <= v < height)
 
 
 if __name__ == "__main__":

@@ -31,7 +31,7 @@ import numpy as np
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.perception.detector import detect
-from bt_humanoid.perception.rgbd_camera import RgbdCamera
+from bt_humanoid.perception.rgbd_camera import RgbdCamera, RgbdFrame
 from bt_humanoid.testing.scene import place_object
 
 PALETTE = {
@@ -135,7 +135,7 @@ def _look_at(run, point: np.ndarray) -> None:
         sim.step()
 
 
-def truths(run, camera: RgbdCamera, names: list[str], colours: dict[str, str]) -> list[Truth]:
+def truths(run, camera: RgbdCamera, frame: RgbdFrame, names: list[str], colours: dict[str, str]) -> list[Truth]:
     """Every object with its centre, kind, colour and visible fraction in the camera image."""
     sim = run.sim
     model, data = sim.model, sim.data
@@ -172,22 +172,11 @@ def truths(run, camera: RgbdCamera, names: list[str], colours: dict[str, str]) -
                 colours.get(name, declared.colour),
                 centre,
                 min(seen.get(body, 0) / alone, 1.0) if alone else 0.0,
-                _in_image(camera, centre),
+                frame.in_image(centre),
             )
         )
     renderer.close()
     return result
-
-
-def _in_image(camera: RgbdCamera, point: np.ndarray) -> bool:
-    data = camera.sim.data
-    rotation = data.cam_xmat[camera.camera].reshape(3, 3)
-    local = rotation.T @ (point - data.cam_xpos[camera.camera])
-    if local[2] >= 0:
-        return False
-    u = camera.width / 2 + camera.focal * local[0] / -local[2]
-    v = camera.height / 2 - camera.focal * local[1] / -local[2]
-    return bool(0 <= u < camera.width and 0 <= v < camera.height)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -213,7 +202,7 @@ def main(argv: list[str] | None = None) -> int:
         t2 = time.perf_counter()
         render_ms.append((t1 - t0) * 1000)
         detect_ms.append((t2 - t1) * 1000)
-        objects = truths(run, camera, list(run.sim.object_bodies), colours)
+        objects = truths(run, camera, frame, list(run.sim.object_bodies), colours)
         camera.close()
         run.close()
         eye = frame.position

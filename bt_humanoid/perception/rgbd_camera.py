@@ -41,6 +41,16 @@ class RgbdFrame:
         """Whether the robot's own body covers this pixel (what lies behind it is unknown, not absent)."""
         return self.hidden is not None and bool(self.hidden[row, col])
 
+    def in_image(self, point: np.ndarray) -> bool:
+        """Whether a world point in front of the camera projects into the image."""
+        local = self.rotation.T @ (np.asarray(point) - self.position)
+        if local[2] >= 0:
+            return False
+        u = self.centre[0] + self.focal * local[0] / -local[2]
+        v = self.centre[1] - self.focal * local[1] / -local[2]
+        height, width = self.depth.shape
+        return bool(0 <= u < width and 0 <= v < height)
+
     def points(self, rows: np.ndarray | None = None, cols: np.ndarray | None = None) -> np.ndarray:
         """World points of pixels (all of them, as (H, W, 3), or the given ones, as (N, 3))."""
         if rows is None or cols is None:
