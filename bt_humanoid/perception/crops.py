@@ -39,11 +39,11 @@ def region_crop(frame: RgbdFrame, region: Region) -> np.ndarray:
     side = int(max(r1 - r0, c1 - c0) * MARGIN) + 4
     top, left = (r0 + r1 - side) // 2, (c0 + c1 - side) // 2
     rgb = _window(frame.rgb, top, left, side).astype(np.float32) / 255.0
-    mask = np.zeros(frame.depth.shape, dtype=np.float32)
-    mask[region.rows, region.cols] = 1.0
+    mask = np.zeros((side, side), dtype=np.float32)  # the window holds the whole region: it is centred, and wider
+    mask[region.rows - top, region.cols - left] = 1.0
     median = float(np.median(frame.depth[region.rows, region.cols]))
     depth = np.clip((_window(frame.depth, top, left, side, fill=median) - median) / DEPTH_SPAN, -1.0, 1.0)
-    extra = np.stack([_window(mask, top, left, side), depth.astype(np.float32)], axis=2)
+    extra = np.stack([mask, depth.astype(np.float32)], axis=2)
     size = (CROP, CROP)
     resized = np.concatenate(  # OpenCV resizes at most four channels at once
         [cv2.resize(rgb, size, interpolation=cv2.INTER_AREA), cv2.resize(extra, size, interpolation=cv2.INTER_AREA)],
