@@ -122,11 +122,7 @@ def _look_at(run, point: np.ndarray) -> None:
     """Point the head at ``point`` (set-up: the initial joint state)."""
     sim = run.sim
     mujoco.mj_forward(sim.model, sim.data)
-    yaw = run.robot.base.pose()[2]
-    neck = sim.data.xpos[sim.model.body("head").id]
-    offset = point - neck
-    pan = math.remainder(math.atan2(offset[1], offset[0]) - yaw, 2 * math.pi)
-    tilt = math.atan2(-offset[2], math.hypot(offset[0], offset[1]))
+    pan, tilt = sim.head_angles_towards(point)
     for joint, value in (("head_pan", pan), ("head_tilt", float(np.clip(tilt, -0.6, 1.1)))):
         sim.set_initial_joint(joint, value)
         sim.data.ctrl[sim.actuator_for_joint(joint)] = value

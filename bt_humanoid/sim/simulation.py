@@ -147,6 +147,20 @@ class Simulation:
         address = self.model.jnt_qposadr[self.model.body_jntadr[body]]
         self.data.qpos[address : address + 7] = np.concatenate([position, quat])
 
+    def head_angles_towards(self, point: np.ndarray) -> tuple[float, float]:
+        """Head pan and tilt (rad, unclipped) that would point the head at ``point`` from the current state.
+
+        For set-up (a test or benchmark view); a running robot aims its camera through its controllers.
+        """
+        tilt_joint = self.robot.head_tilt
+        if tilt_joint is None:
+            raise ValueError(f"robot '{self.robot.name}' has no head to aim")
+        head = self.data.xpos[self.model.jnt_bodyid[self.model.joint(tilt_joint).id]]
+        base_yaw = float(self.data.qpos[self.model.joint(self.robot.base.joints["yaw"]).qposadr[0]])
+        offset = np.asarray(point) - head
+        pan = math.remainder(math.atan2(offset[1], offset[0]) - base_yaw, 2 * math.pi)
+        return pan, math.atan2(-offset[2], math.hypot(offset[0], offset[1]))
+
     def set_initial_joint(self, joint: str, value: float) -> None:
         """Initial conditions only (reset and test set-up), never to move things."""
         self.data.qpos[self.model.joint(joint).qposadr[0]] = value

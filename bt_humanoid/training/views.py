@@ -227,11 +227,7 @@ class ViewMaker:
         """Point the head at a random point of ``surface`` (the robot's pose must be forwarded first)."""
         sim = self.sim
         target = np.array([*rng.uniform(surface.region[0], surface.region[1]), surface.height])
-        neck = sim.data.xpos[sim.model.body("head").id]
-        base_yaw = float(sim.data.qpos[sim.model.joint(sim.robot.base.joints["yaw"]).qposadr[0]])
-        offset = target - neck
-        pan = math.remainder(math.atan2(offset[1], offset[0]) - base_yaw, 2 * math.pi)
-        tilt = math.atan2(-offset[2], math.hypot(offset[0], offset[1]))
+        pan, tilt = sim.head_angles_towards(target)
         sim.set_initial_joint("head_pan", float(np.clip(pan + rng.normal(0, 0.1), -1.5, 1.5)))
         sim.set_initial_joint("head_tilt", float(np.clip(tilt + rng.normal(0, 0.08), -0.6, 1.1)))
         mujoco.mj_forward(sim.model, sim.data)
