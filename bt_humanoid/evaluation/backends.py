@@ -27,7 +27,7 @@ def _pin_worker(cores: list[int], counter) -> None:
 
 
 def run_local(
-    suite_file: str, indices: list[int], seed: int, workers: int, scene: str | None = None
+    suite_file: str, indices: list[int], seed: int, workers: int, scene: str | None = None, plan_only: bool = False
 ) -> Iterator[dict[str, Any]]:
     """Episodes in ``workers`` processes (spawned: each has its own MuJoCo and renderers), or in this one."""
     cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
@@ -36,7 +36,7 @@ def run_local(
             if cores:
                 os.sched_setaffinity(0, {cores[0]})
             for index in indices:
-                yield run_episode(suite_file, index, seed, scene=scene)
+                yield run_episode(suite_file, index, seed, scene=scene, plan_only=plan_only)
         finally:
             if cores:
                 os.sched_setaffinity(0, set(cores))
@@ -44,13 +44,18 @@ def run_local(
     context = multiprocessing.get_context("spawn")
     counter = context.Value("i", 0)
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_pin_worker, initargs=(cores, counter)) as pool:
-        futures = [pool.submit(run_episode, suite_file, index, seed, None, scene) for index in indices]
+        futures = [pool.submit(run_episode, suite_file, index, seed, None, scene, plan_only) for index in indices]
         for future in as_completed(futures):
             yield future.result()
 
 
 def run_ray(
-    suite_file: str, indices: list[int], seed: int, address: str | None, scene: str | None = None
+    suite_file: str,
+    indices: list[int],
+    seed: int,
+    address: str | None,
+    scene: str | None = None,
+    plan_only: bool = False,
 ) -> Iterator[dict[str, Any]]:
     """Episodes as Ray tasks, one CPU each, on the cluster at ``address`` (or a local Ray instance)."""
     try:
@@ -62,7 +67,7 @@ def run_ray(
     if not ray.is_initialized():
         ray.init(address=address, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
     remote = ray.remote(num_cpus=1)(run_episode)
-    pending = [remote.remote(suite_file, index, seed, None, scene) for index in indices]
+    pending = [remote.remote(suite_file, index, seed, None, scene, plan_only) for index in indices]
     while pending:
         finished, pending = ray.wait(pending, num_returns=1)
         yield ray.get(finished[0])

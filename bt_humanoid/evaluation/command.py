@@ -34,6 +34,12 @@ def _parser() -> _Parser:
         metavar="NAME|FILE",
         help="the scene episodes start from: a name in the world's scenes/ or a scene file (default: the suite's)",
     )
+    parser.add_argument(
+        "--plan-only",
+        action="store_true",
+        help="household suites: plan each instruction and judge the plan, run nothing in physics (seconds, not hours)",
+    )
+    parser.add_argument("--family", help="household suites: only the instructions of this family")
     parser.add_argument("--workers", type=int, default=1, help="worker processes, one core each (default 1)")
     parser.add_argument("--backend", choices=["local", "ray"], default="local", help="where episodes run")
     parser.add_argument("--address", help="Ray cluster address for --backend ray (default: start a local Ray)")
@@ -64,14 +70,22 @@ def eval_main(argv: list[str] | None = None) -> int:
         suite, _ = load_suite(file, args.scene)
         if args.scene is not None:
             args.scene = suite.scene  # a file's path made absolute: the workers may start elsewhere
-        episodes = args.episodes or suite.episodes
+        episodes = min(args.episodes or suite.episodes, len(suite.instructions) or 10**9)
+        indices = list(range(episodes))
+        if args.family is not None:
+            if not suite.instructions:
+                raise UserError("--family is for suites of instructions (household)")
+            indices = [i for i in indices if suite.instructions[i].family == args.family]
+            if not indices:
+                known = sorted({i.family for i in suite.instructions})
+                raise UserError(f"--family {args.family}: no such instructions", hint=f"one of {', '.join(known)}")
         seed = suite.seed if args.seed is None else args.seed
         console.print(
-            f"bt-eval [bold]{suite.suite}[/]: {episodes} episodes, seed {seed}, "
+            f"bt-eval [bold]{suite.suite}[/]: {len(indices)} episodes, seed {seed}, "
             f"{args.workers if args.backend == 'local' else 'ray'} worker(s) — {suite.description}"
         )
         commit = source_commit()  # before the run: the code the episodes ran, whatever is edited meanwhile
-        records, wall = _run(str(file.resolve()), list(range(episodes)), seed, args, console)
+        records, wall = _run(str(file.resolve()), indices, seed, args, console)
     except UserError as error:
         return _fail_invalid(error)
     records.sort(key=lambda r: r["episode"])
@@ -124,9 +138,9 @@ def _run(file: str, indices: list[int], seed: int, args, console: Console) -> tu
     from bt_humanoid.evaluation.backends import run_local, run_ray
 
     stream = (
-        run_ray(file, indices, seed, args.address, args.scene)
+        run_ray(file, indices, seed, args.address, args.scene, args.plan_only)
         if args.backend == "ray"
-        else run_local(file, indices, seed, args.workers, args.scene)
+        else run_local(file, indices, seed, args.workers, args.scene, args.plan_only)
     )
     records: list[dict[str, Any]] = []
     started = time.perf_counter()
@@ -143,8 +157,14 @@ def _run(file: str, indices: list[int], seed: int, args, console: Console) -> tu
         for record in stream:
             records.append(record)
             wins = sum(r["success"] for r in records)
-            progress.update(bar, advance=1, rate=f"{wins}/{len(records)} succeeded")
-            if not record["success"]:
+            rate = f"{wins}/{len(records)} succeeded"
+            if "planned" in record:
+                rate = f"{sum(r['planned'] for r in records)}/{len(records)} planned right, " + rate
+            progress.update(bar, advance=1, rate=rate)
+            if record.get("plan_failure"):
+                said = f"  episode {record['episode']} ({record['command']})"
+                progress.console.print(f"{said}: plan {record['plan_failure']}")
+            elif not record["success"] and not args.plan_only:
                 progress.console.print(
                     f"  episode {record['episode']} ({record['command'] or record['task']}"
                     f"{', fault ' + record['fault'] if record['fault'] else ''}): {record['failure']}"
@@ -160,11 +180,18 @@ def _percent(rate: dict[str, Any]) -> str:
 def _print(console: Console, figures: dict[str, Any]) -> None:
     table = Table(title=f"{figures['suite']}: success with 95 % confidence interval", title_justify="left")
     table.add_column("group")
-    table.add_column("success")
-    table.add_row("all", _percent(figures["success"]))
-    for key in ("by_task", "by_object", "by_fault"):
-        for name, rate in figures[key].items():
-            table.add_row(f"{key[3:]}: {name}", _percent(rate))
+    if "planning" in figures:  # household instructions: the plan and the run, per family
+        table.add_column("planned right")
+        table.add_column("done")
+        table.add_row("all", _percent(figures["planning"]), _percent(figures["success"]))
+        for family, rates in figures["by_family"].items():
+            table.add_row(family, _percent(rates["planned"]), _percent(rates["success"]))
+    else:
+        table.add_column("success")
+        table.add_row("all", _percent(figures["success"]))
+        for key in ("by_task", "by_object", "by_fault"):
+            for name, rate in figures[key].items():
+                table.add_row(f"{key[3:]}: {name}", _percent(rate))
     console.print(table)
 
     def ms(value: float | None, unit: str = "ms", digits: int = 1) -> str:

@@ -78,6 +78,7 @@ def run_episode(
     seed: int | None = None,
     events: list[dict[str, Any]] | None = None,
     scene: str | None = None,
+    plan_only: bool = False,
 ) -> dict[str, Any]:
     """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``; its scene, or ``scene``: a
     name, or a file's absolute path); figures and verdict as a dict.
@@ -88,6 +89,10 @@ def run_episode(
     suite = _suite(suite_file, scene)
     if seed is not None:
         suite = suite.model_copy(update={"seed": seed})
+    if suite.instructions:
+        from bt_humanoid.evaluation.household import run_instruction  # it builds on this module's judging
+
+        return run_instruction(suite, suite_file, index, plan_only)
     draw = Draw(suite, index)
     task = suite.tasks[draw.task_index]
     fault = suite.faults.kinds[draw.fault_index] if draw.fault_index is not None else None
@@ -202,21 +207,10 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
     expect = fill(task.expect, draw.slots)
     spec = _mission(suite, suite_file, task, draw, stack, figures)
     if isinstance(spec, str):
-        return _verdict(stack, None, expect, figures, failure=spec)
+        return episode_verdict(stack, None, figures, expect, failure=spec)
     run = MissionRun(stack, spec)
     injector = _arm(fault, run, draw) if fault is not None else None
-    model = run.sim.model
-    on_person = np.isin(model.geom_bodyid, sorted(run.truth.people_bodies()))  # per geom
-    on_robot = np.isin(model.geom_bodyid, sorted(run.sim.robot_bodies))  # per geom
-    touched: list[float] = []
-
-    def watch_people() -> None:  # every control step: vectorised over the contacts
-        contacts = run.sim.data.contact
-        g1, g2 = contacts.geom1, contacts.geom2
-        if np.any((on_person[g1] & on_robot[g2]) | (on_person[g2] & on_robot[g1])):
-            touched.append(run.sim.time)
-
-    stack.observers.append(watch_people)
+    touched = watch_people(run, stack)
     result = run.execute()
     if isinstance(injector, fault_kinds.NewCommand) and injector.fired is not None:
         rest = next((e["t"] for e in reversed(result.events.events) if e["event"] in ("rest", "moving")), None)
@@ -225,9 +219,26 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
         expect = fill(injector.settings.expect, draw.slots)
         follow = _planned(command, suite, stack, figures)
         if isinstance(follow, str):
-            return _verdict(stack, result, expect, figures, failure=follow, injector=injector, touched=touched)
+            return episode_verdict(stack, result, figures, expect, failure=follow, injector=injector, touched=touched)
         result = MissionRun(stack, follow).execute()
-    return _verdict(stack, result, expect, figures, injector=injector, touched=touched)
+    return episode_verdict(stack, result, figures, expect, injector=injector, touched=touched)
+
+
+def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:
+    """The simulation times at which the robot touches a person, filled while the run steps."""
+    model = run.sim.model
+    on_person = np.isin(model.geom_bodyid, sorted(run.truth.people_bodies()))  # per geom
+    on_robot = np.isin(model.geom_bodyid, sorted(run.sim.robot_bodies))  # per geom
+    touched: list[float] = []
+
+    def watch() -> None:  # every control step: vectorised over the contacts
+        contacts = run.sim.data.contact
+        g1, g2 = contacts.geom1, contacts.geom2
+        if np.any((on_person[g1] & on_robot[g2]) | (on_person[g2] & on_robot[g1])):
+            touched.append(run.sim.time)
+
+    stack.observers.append(watch)
+    return touched
 
 
 def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, stack: RobotStack, figures: dict):
@@ -268,17 +279,17 @@ def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:
     raise AssertionError(f"no injector for {kind}")
 
 
-def _verdict(
+def episode_verdict(
     run: RobotStack,
     result,
-    expect: list[dict[str, Any]],
     figures: dict[str, Any],
+    expect: list[dict[str, Any]] | None = None,
     failure: str | None = None,
     injector: fault_kinds.Injector | None = None,
     touched: list[float] | None = None,
 ) -> dict[str, Any]:
     """Success in ground truth, and the figures the suite aggregates."""
-    header = MissionHeader.model_validate({"mission": "expect", "success": expect})
+    header = MissionHeader.model_validate({"mission": "expect", "success": expect or []})
     conditions = list(header.success)
     world, kinds = run.context.world, run.sim.object_kinds
     for condition in header.success:  # things people keep upright must arrive upright

@@ -23,8 +23,8 @@ def wilson_interval(successes: int, trials: int, z: float = Z95) -> tuple[float,
     return (max(0.0, centre - half), min(1.0, centre + half))
 
 
-def _rate(episodes: list[dict[str, Any]]) -> dict[str, Any]:
-    wins = sum(e["success"] for e in episodes)
+def _rate(episodes: list[dict[str, Any]], key: str = "success") -> dict[str, Any]:
+    wins = sum(e[key] for e in episodes)
     low, high = wilson_interval(wins, len(episodes))
     return {"episodes": len(episodes), "successes": wins, "rate": wins / len(episodes), "ci95": [low, high]}
 
@@ -52,8 +52,16 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
     sim = sum(e["sim_time"] for e in episodes)
     busy = sum(e["wall_s"] for e in episodes)
     latencies = [e["stop_latency_s"] for e in episodes if e["stop_latency_s"] is not None]
+    planning = {}
+    if episodes and "planned" in episodes[0]:  # household instructions: the plan judged too, per family
+        families = _groups(episodes, "family", "-")
+        planning = {
+            "planning": _rate(episodes, "planned"),
+            "by_family": {k: {"planned": _rate(v, "planned"), "success": _rate(v)} for k, v in families.items()},
+        }
     return {
         "success": _rate(episodes),
+        **planning,
         "by_task": {k: _rate(v) for k, v in by["task"].items()},
         "by_object": {k: _rate(v) for k, v in by["object"].items()},
         "by_fault": {k: _rate(v) for k, v in by["fault"].items()},
@@ -74,11 +82,19 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
         "wall_s": round(wall_s, 1),
         "workers": workers,
         "failures": [
-            {"episode": e["episode"], "task": e["command"], "fault": e["fault"], "failure": e["failure"]}
+            {"episode": e["episode"], "task": e["command"], "fault": e["fault"], "failure": _failure(e)}
             for e in episodes
-            if not e["success"]
+            if not e["success"] or e.get("plan_failure")
         ],
     }
+
+
+def _failure(episode: dict[str, Any]) -> str:
+    """Why an episode failed: its plan (household instructions judge it too), its run, or both."""
+    plan = episode.get("plan_failure")
+    if plan is None:
+        return episode["failure"]
+    return f"plan: {plan}" + (f"; run: {episode['failure']}" if episode["failure"] else "")
 
 
 def markdown(figures: dict[str, Any], command: str) -> str:
@@ -94,7 +110,14 @@ def markdown(figures: dict[str, Any], command: str) -> str:
 
     rows = ["| group | success | 95 % interval | episodes |", "| --- | --- | --- | --- |"]
     rows.append(f"| all | {rate(figures['success'])} |")
+    if "planning" in figures:
+        rows.append(f"| planned right, all | {rate(figures['planning'])} |")
+        for name, rates in figures["by_family"].items():
+            rows.append(f"| planned right, {name} | {rate(rates['planned'])} |")
+            rows.append(f"| done, {name} | {rate(rates['success'])} |")
     for key, label in (("by_task", "task"), ("by_object", "object"), ("by_fault", "fault")):
+        if key == "by_task" and "planning" in figures:
+            continue  # a household episode's task is its family
         rows += [f"| {label}: {name} | {rate(r)} |" for name, r in sorted(figures[key].items())]
     done, latency = figures["time_to_complete_s"], figures["stop_latency_s"]
     lines = [

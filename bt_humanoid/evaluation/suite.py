@@ -18,6 +18,7 @@ from pydantic import Field, model_validator
 
 from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.evaluation.faults import FAULT_MODELS, FaultConfig
+from bt_humanoid.evaluation.goals import Catalogue, Goal
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.sim.scene_config import Placement, SceneConfig, load_scene
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
@@ -42,6 +43,18 @@ class Task(StrictModel):
         if self.command is not None and not self.expect:
             raise ValueError("a command task needs expect: (the conditions that mean it was done)")
         return self
+
+
+FAMILIES = ("primitives", "verbs", "nouns", "structured", "embodiment", "crowd", "long_horizon")
+
+
+class Instruction(StrictModel):
+    """One household instruction: what a person says, in which scene, and what must be true when it is done."""
+
+    say: str = Field(min_length=1, description="what the person types (or says)")
+    family: Literal[FAMILIES] = Field(description="the family of instructions it belongs to (SayCan's)")  # type: ignore[valid-type]
+    scene: str = Field(description="the scene it starts from: a name in the world's scenes/, or a file")
+    expect: list[Goal] = Field(min_length=1, description="what must be true at the end (evaluation/goals.py)")
 
 
 class SceneDraw(StrictModel):
@@ -107,10 +120,21 @@ class Suite(StrictModel):
     seed: int = Field(0, ge=0, description="draws every episode's scene, task and fault")
     objects: list[str] = Field(default_factory=list, description="objects for {object}, one drawn per episode")
     surfaces: list[str] = Field(default_factory=list, description="surfaces for {surface}, one drawn per episode")
-    tasks: list[Task] = Field(min_length=1)
+    tasks: list[Task] = Field(default_factory=list, description="kinds of episode, drawn per episode")
+    instructions: list[Instruction] = Field(
+        default_factory=list, description="household instructions, one episode each, in order (instead of tasks)"
+    )
     randomize: Randomize = Randomize()
     faults: FaultPlan = FaultPlan()
     time_budget: float = Field(300.0, gt=0, le=86400, description="simulation seconds per episode")
+
+    @model_validator(mode="after")
+    def _tasks_or_instructions(self) -> Suite:
+        if bool(self.tasks) == bool(self.instructions):
+            raise ValueError("give tasks: (episodes drawn from them) or instructions: (one episode each), not both")
+        if self.instructions and "episodes" not in self.model_fields_set:
+            self.episodes = len(self.instructions)
+        return self
 
 
 def load_suite(file: Path, scene: str | None = None) -> tuple[Suite, WorldConfig]:
@@ -133,6 +157,7 @@ def load_suite(file: Path, scene: str | None = None) -> tuple[Suite, WorldConfig
     _check_scene_draw(suite, world, source)
     _check_objects_in_scene(suite, world, start, source)
     _check_tasks(suite, source, _names_scene(suite, world, start))
+    _check_instructions(suite, world, source, file.parent)
     return suite, world
 
 
@@ -274,3 +299,43 @@ def fill(value: Any, slots: dict[str, str]) -> Any:
     if isinstance(value, dict):
         return {key: fill(item, slots) for key, item in value.items()}
     return value
+
+
+def instruction_scene(suite: Suite, index: int, folder: Path, world: WorldConfig) -> SceneConfig:
+    """The scene instruction ``index`` starts from (a name, or a file relative to the suite's ``folder``)."""
+    scene = suite.instructions[index].scene
+    return load_scene(world, str(folder / scene) if Path(scene).suffix in (".yaml", ".yml") else scene)
+
+
+def _check_instructions(suite: Suite, world: WorldConfig, source: YamlSource, folder: Path) -> None:
+    """Each instruction's scene loads, and its goals name things of that scene, in numbers it holds."""
+    for index, instruction in enumerate(suite.instructions):
+        at = ("instructions", index)
+        try:
+            scene = instruction_scene(suite, index, folder, world)
+        except UserError as error:
+            raise UserError(error.message, where=source.where((*at, "scene")), hint=error.hint) from None
+        catalogue = Catalogue.of_scene(world, scene)
+        for number, goal in enumerate(instruction.expect):
+            where = source.where((*at, "expect", number))
+            for word in goal.selector:
+                if not catalogue.known(word):
+                    raise UserError(f"'{word}' names nothing in world '{world.name}'", where=where)
+            if goal.selector and not catalogue.matching(goal.selector):
+                raise UserError(f"nothing in scene '{scene.name}' is a {' or '.join(goal.selector)}", where=where)
+            needed = goal.count if isinstance(goal.count, int) else 1
+            if goal.selector and len(catalogue.matching(goal.selector)) < needed:
+                raise UserError(
+                    f"count {needed}, but scene '{scene.name}' has {len(catalogue.matching(goal.selector))}",
+                    where=where,
+                )
+            names = [
+                (goal.on[1] if goal.on else None, [*world.surfaces, "any"]),
+                (goal.cleared, list(world.surfaces)),
+                (goal.inside[1] if goal.inside else None, list(world.containers)),
+                (goal.at, [*world.places, "person"]),
+                *((place, list(world.places)) for place in goal.visited or []),
+            ]
+            for name, known in names:
+                if name is not None and name not in known:
+                    raise UserError(f"unknown name '{name}'", where=where, hint=did_you_mean(name, known))

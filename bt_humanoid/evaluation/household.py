@@ -1,0 +1,106 @@
+"""One household instruction as an episode: plan it from what the robot sees, judge the plan, run it, judge the run.
+
+A suite with ``instructions:`` (missions/benchmarks/household.yaml) runs
+episode ``i`` as instruction ``i``, from that instruction's scene. Two
+verdicts come out, both against the instruction's ``expect:`` goals
+(``goals.py``): *planned* — the plan, carried out symbolically, does what was
+asked and nothing more — and *success* — the run, judged in the simulator's
+ground truth, did it.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bt_humanoid.commanding import plan_command
+from bt_humanoid.engine.runner import MissionRun
+from bt_humanoid.engine.stack import RobotStack
+from bt_humanoid.evaluation.goals import (
+    Catalogue,
+    PlanInvalid,
+    overreach,
+    places_reached,
+    plan_situation,
+    scene_situation,
+    truth_situation,
+    unmet,
+)
+from bt_humanoid.evaluation.suite import Suite, instruction_scene
+from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.sim.world_config import load_world_config
+
+VISIT_EVERY = 25  # control steps between looks at which place the robot stands at (visited: goals)
+
+
+def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool = False) -> dict[str, Any]:
+    """Plan and (unless ``plan_only``) run instruction ``index``; the record bt-eval aggregates."""
+    from bt_humanoid.evaluation.episode import episode_verdict, watch_people  # episode.py dispatches here
+
+    started = time.perf_counter()
+    instruction = suite.instructions[index]
+    world = load_world_config(suite.world)
+    scene = instruction_scene(suite, index, Path(suite_file).parent, world)
+    seed = int(np.random.SeedSequence([suite.seed, index]).generate_state(1)[0])
+    stack = RobotStack.load(suite.world, suite.robot, seed, scene=scene)
+    record: dict[str, Any] = {
+        "episode": index,
+        "task": instruction.family,
+        "family": instruction.family,
+        "command": instruction.say,
+        "scene": scene.name,
+        "object": None,
+        "surface": None,
+        "fault": None,
+    }
+    try:
+        stack.look()
+        catalogue = Catalogue.of_scene(world, scene)
+        start = scene_situation(scene, world)
+        clock = time.perf_counter()
+        outcome = plan_command(instruction.say, stack.planning_context(), lambda question: None)
+        figures: dict[str, Any] = {"plan_ms": [round((time.perf_counter() - clock) * 1000, 2)], "stop_latency_s": None}
+        plan = outcome.plan
+        record["plan"] = plan.say
+        record["plan_failure"] = _judge_plan(plan, start, catalogue, world, instruction.expect)
+        record["planned"] = record["plan_failure"] is None
+        if plan_only or plan.kind != "mission" or plan.mission is None:
+            failure = "not run (--plan-only)" if plan_only else f"planner: {plan.say}"
+            record |= episode_verdict(stack, None, figures, failure=failure)
+        else:
+            mission = {**plan.mission, "safety": {"time_budget": suite.time_budget}}
+            run = MissionRun(stack, MissionLoader.for_plans().load_data(mission, name="<command>"))
+            touched = watch_people(run, stack)
+            visited: set[str] = set()
+            steps = [0]
+
+            def watch_places() -> None:
+                steps[0] += 1
+                if steps[0] % VISIT_EVERY == 0:
+                    visited.update(places_reached(run.truth))
+
+            stack.observers.append(watch_places)
+            result = run.execute()
+            record |= episode_verdict(stack, result, figures, touched=touched)
+            missing = unmet(instruction.expect, start, truth_situation(run.truth, visited), catalogue)
+            if record["success"] and missing:
+                record["success"], record["failure"] = False, "not done: " + "; ".join(missing)
+    finally:
+        stack.close()
+    record["wall_s"] = round(time.perf_counter() - started, 3)
+    return record
+
+
+def _judge_plan(plan, start, catalogue: Catalogue, world, goals) -> str | None:
+    """Why a plan does not do what the instruction asks (None: it does)."""
+    if plan.kind != "mission" or plan.mission is None:
+        return f"{plan.kind}: {plan.say}"
+    try:
+        end = plan_situation(plan.mission["tree"], start, world)
+    except PlanInvalid as invalid:
+        return f"the plan {invalid}"
+    problems = unmet(goals, start, end, catalogue) + overreach(goals, start, end, catalogue)
+    return "; ".join(problems) if problems else None
