@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -58,17 +59,47 @@ class YamlSource:
         return UserError(f"{prefix}{message}", where=self.where((*base, *location)))
 
 
+_PARSED: dict[tuple[str, int, int], YamlSource] = {}  # files read before, by path, modification time and size
+_PARSED_MAX = 256
+
+
 def read_yaml(file: Path, text: str | None = None) -> YamlSource:
-    """Parse one YAML document; syntax errors become UserErrors at file:line."""
+    """Parse one YAML document; syntax errors become UserErrors at file:line.
+
+    A file read before and unchanged since is not parsed again (a planned mission reads the world's, the robot's
+    and the behaviours' files each time): the caller gets its own copy of the data.
+    """
     if text is None:
         try:
-            text = file.read_text()
-        except FileNotFoundError:
-            raise UserError("file not found", where=display_path(file)) from None
-        except OSError as error:
-            raise UserError(f"cannot read: {error.strerror}", where=display_path(file)) from None
-        except UnicodeDecodeError:
-            raise UserError("not a text file (UTF-8 expected)", where=display_path(file)) from None
+            stat = file.stat()
+        except OSError:
+            stat = None
+        key = (str(file.resolve()), stat.st_mtime_ns, stat.st_size) if stat is not None else None
+        if key is not None and key in _PARSED:
+            parsed = _PARSED[key]
+            return YamlSource(file, copy.deepcopy(parsed.data), parsed.lines)
+        source = _read_file(file)
+        if key is not None:
+            if len(_PARSED) >= _PARSED_MAX:
+                _PARSED.pop(next(iter(_PARSED)))
+            _PARSED[key] = YamlSource(file, copy.deepcopy(source.data), source.lines)
+        return source
+    return _parse(file, text)
+
+
+def _read_file(file: Path) -> YamlSource:
+    try:
+        text = file.read_text()
+    except FileNotFoundError:
+        raise UserError("file not found", where=display_path(file)) from None
+    except OSError as error:
+        raise UserError(f"cannot read: {error.strerror}", where=display_path(file)) from None
+    except UnicodeDecodeError:
+        raise UserError("not a text file (UTF-8 expected)", where=display_path(file)) from None
+    return _parse(file, text)
+
+
+def _parse(file: Path, text: str) -> YamlSource:
     try:
         loader = yaml.SafeLoader(text)  # checks the characters first: control characters are refused here
     except yaml.YAMLError as error:
