@@ -30,6 +30,7 @@ from bt_humanoid.mission.schema import RecoverySettings
 from bt_humanoid.mission.spec import MissionSpec, NodeSpec
 from bt_humanoid.perception.grounding import resolve
 from bt_humanoid.skills.params import named_objects
+from bt_humanoid.skills.perception_skills import LOOK_AROUND
 
 MAX_QUESTIONS = 3  # answers taken per command; still unclear after them, the question stands and nothing runs
 
@@ -38,6 +39,21 @@ MAX_QUESTIONS = 3  # answers taken per command; still unclear after them, the qu
 class CommandOutcome:
     plan: Plan  # the last answer of the planner
     spec: MissionSpec | None  # the validated mission, when there is one to run
+
+
+def look_around(stack: RobotStack) -> None:
+    """Look ahead, left and right with the head (as ``find`` does), then ahead again: what a person glances at
+    before answering a request, so that the planner knows what stands beside the robot, not only in front.
+    Real head motion in physics (a few seconds of simulated time); a robot without a panning head looks once."""
+    pan = stack.robot_config.head_pan
+    stack.look()
+    if pan is None or stack.perceiver is None:
+        return
+    turns = [{"move_joints": {"joints": {pan: angle}}} for angle in (*LOOK_AROUND[1:], 0.0)]
+    glance = {"mission": "look around", "world": stack.world.name, "robot": stack.robot_config.name}
+    spec = MissionLoader.for_plans().load_data({**glance, "tree": {"sequence": turns}}, name="<look around>")
+    MissionRun(stack, spec).execute()
+    stack.look()
 
 
 def make_planner(settings: LlmSettings | None) -> EmbeddedPlanner | LlmPlanner:

@@ -170,13 +170,15 @@ def unmet(goals: list[Goal], start: Situation, end: Situation, catalogue: Catalo
 
 
 def overreach(goals: list[Goal], start: Situation, end: Situation, catalogue: Catalogue) -> list[str]:
-    """What a plan does beyond what was asked: a thing moved that no goal covers, or more than a count asked."""
+    """What a plan does beyond what was asked: a thing moved that no goal covers, or more than a count asked. A
+    thing held at the start may be set down on a surface: the hand is needed for what was asked."""
     moved = [n for n, w in end.things.items() if w != start.things[n]]
     problems = []
     for name in moved:
         covering = [g for g in goals if name in catalogue.matching(g.selector) and g.wants(end.things[name])]
         cleared = [g for g in goals if g.cleared is not None and start.things[name] == ("on", g.cleared)]
-        if not covering and not cleared:
+        set_down = start.things[name][0] == "hand" and end.things[name][0] == "on"  # to free the hand: fine
+        if not covering and not cleared and not set_down:
             problems.append(f"{name} moved to {_say(end.things[name])}, which was not asked")
     for goal in goals:
         if isinstance(goal.count, int) and goal.selector:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from bt_humanoid.commanding import plan_command
+from bt_humanoid.commanding import look_around, plan_command
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.evaluation.goals import (
@@ -57,7 +57,7 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
         "fault": None,
     }
     try:
-        stack.look()
+        look_around(stack)
         catalogue = Catalogue.of_scene(world, scene)
         start = scene_situation(scene, world)
         clock = time.perf_counter()
