@@ -223,25 +223,29 @@ class PlanInvalid(Exception):
     """A step the plan cannot carry out in the situation it reaches (taking with a full hand, an unknown thing)."""
 
 
-def plan_situation(tree: dict[str, Any], start: Situation, world: WorldConfig) -> Situation:
-    """Where things end if every step of a plan does what it says (a symbolic run of the mission tree)."""
+def plan_situation(
+    tree: dict[str, Any], start: Situation, world: WorldConfig, instances: dict[str, str] | None = None
+) -> Situation:
+    """Where things end if every step of a plan does what it says (a symbolic run of the mission tree).
+    ``instances``: the scene instance each robot id a plan may use stands for."""
     state = Situation(dict(start.things), start.robot_at, set(start.visited))
-    _carry_out(tree, state, world)
+    _carry_out(tree, state, world, instances or {})
     return state
 
 
-def _carry_out(node: dict[str, Any], state: Situation, world: WorldConfig) -> None:
+def _carry_out(node: dict[str, Any], state: Situation, world: WorldConfig, instances: dict[str, str]) -> None:
     kind, params = next(iter(node.items()))
     if kind in ("name", "description"):  # a node's label sits beside its kind
         kind, params = next((k, v) for k, v in node.items() if k not in ("name", "description"))
     if kind in ("sequence", "fallback", "parallel"):
         children = params if isinstance(params, list) else params["children"]
         for child in children if kind != "fallback" else children[:1]:  # a fallback does its first choice
-            _carry_out(child, state, world)
+            _carry_out(child, state, world, instances)
         return
     params = params or {}
     if kind in ("take", "fetch", "throw_away", "pick"):
-        _take(str(params["object"]), state)
+        name = str(params["object"])
+        _take(instances.get(name, name), state)
     if kind in ("fetch", "place"):
         surface = str(params.get("to") or params.get("surface"))
         state.things[_held(state, kind)] = ("on", surface)

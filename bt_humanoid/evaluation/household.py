@@ -65,7 +65,7 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
         figures: dict[str, Any] = {"plan_ms": [round((time.perf_counter() - clock) * 1000, 2)], "stop_latency_s": None}
         plan = outcome.plan
         record["plan"] = plan.say
-        record["plan_failure"] = _judge_plan(plan, start, catalogue, world, instruction.expect)
+        record["plan_failure"] = _judge_plan(plan, start, catalogue, world, instruction.expect, _instances(stack))
         record["planned"] = record["plan_failure"] is None
         if plan_only or plan.kind != "mission" or plan.mission is None:
             failure = "not run (--plan-only)" if plan_only else f"planner: {plan.say}"
@@ -94,12 +94,24 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
     return record
 
 
-def _judge_plan(plan, start, catalogue: Catalogue, world, goals) -> str | None:
+def _instances(stack: RobotStack) -> dict[str, str]:
+    """The scene's instance each believed object is (by where it stands in ground truth): a plan may name a thing
+    by the robot's own id ("bottle-2", the second of two waters), and the judge must know which it is."""
+    truth, names = stack.truth, list(stack.sim.object_bodies)
+    found = {}
+    for tracked in stack.context.world_model.present():
+        distances = [float(np.linalg.norm(truth.object_position(n) - tracked.position)) for n in names]
+        if distances and min(distances) < 0.15:
+            found[tracked.id] = names[int(np.argmin(distances))]
+    return found
+
+
+def _judge_plan(plan, start, catalogue: Catalogue, world, goals, instances: dict[str, str]) -> str | None:
     """Why a plan does not do what the instruction asks (None: it does)."""
     if plan.kind != "mission" or plan.mission is None:
         return f"{plan.kind}: {plan.say}"
     try:
-        end = plan_situation(plan.mission["tree"], start, world)
+        end = plan_situation(plan.mission["tree"], start, world, instances)
     except PlanInvalid as invalid:
         return f"the plan {invalid}"
     problems = unmet(goals, start, end, catalogue) + overreach(goals, start, end, catalogue)

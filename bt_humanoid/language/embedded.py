@@ -29,9 +29,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from lemminflect import getAllLemmas
 
+from bt_humanoid.language.phrases import Wanted, category_words, is_open, read_wanted
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
-from bt_humanoid.language.vocabulary import BIN_VERBS, INTENTS, WorldVocabulary, every_verb
+from bt_humanoid.language.reading import is_context, lexicon_words, read
+from bt_humanoid.language.vocabulary import BIN_VERBS, INTENTS, WorldVocabulary, split_clauses
 from bt_humanoid.language.words import normalise
 from bt_humanoid.perception.free_space import free_spot
 from bt_humanoid.perception.grounding import COLOURS, KIND_WORDS, describes_an_object, ground
@@ -52,11 +55,7 @@ DEFAULT_TURN = 90.0  # degrees for "turn left" without a number
 DEFAULT_STEP = 1.0  # m for "walk forward" without a number
 MAX_STEP = 5.0  # m: a longer relative move is a job for "go to"
 PERSON_WORDS = {"me", "us", "the user", "user", "the person", "person", "here"}
-CLAUSE_BREAK = re.compile(r"\s*(?:,\s*)?(?:\band then\b|\bthen\b|\bafter that\b|\band\b|,)\s*")
 ARTICLE = re.compile(r"^(?:the|a|an|some|my|your|that|this)\s+")
-
-VERB = "(?:" + "|".join(re.escape(verb) for verb in every_verb()) + r")\b"
-STARTS_WITH_VERB = re.compile(rf"^{VERB}")
 
 
 def _verbs(*intents: str) -> str:
@@ -87,37 +86,26 @@ PATTERNS: list[tuple[str, re.Pattern[str]]] = [
         ),
     ),
     ("face", re.compile(rf"^{_verbs('face')}\s+(?P<where>.+)$")),
-    ("bring_me", re.compile(rf"^{_verbs('bring_me')}\s+(?:me|us)\s+(?P<what>.+)$")),
-    (
-        "bring_to",
-        re.compile(
-            rf"^{_verbs('carry_to_surface', 'carry_to_person')}\s+(?P<what>.+?)\s+"
-            r"(?:over\s+)?(?:to|onto|over to|into|back to)\s+(?P<where>.+)$"  # "on the table" says where it is
-        ),
-    ),
-    ("bring_me", re.compile(rf"^{_verbs('bring_here')}\s+(?P<what>.+?)\s+(?:here|over here|back)$")),
-    ("throw_away", re.compile(r"^(?:throw|toss|chuck)\s+(?P<what>.+?)\s+(?:away|out)$")),  # "throw the can away"
-    ("throw_away", re.compile(rf"^(?P<verb>{_verbs('throw_away')})\s+(?P<what>.+)$")),
-    (
-        "put",
-        re.compile(
-            rf"^{_verbs('put')}\s+(?:down\s+)?(?P<what>.+?)\s+(?:down\s+)?"
-            r"(?:on top of|onto|on|into|in)\s+(?P<where>.+)$"
-        ),
-    ),
-    ("put_down", re.compile(rf"^{_verbs('put')}\s+(?:down\s+)?(?P<what>.+?)(?:\s+down)?$")),
     ("come", re.compile(rf"^{_verbs('come')}$")),
-    (
-        "go",
-        re.compile(
-            rf"^{_verbs('go')}\s+(?:back\s+)?(?:over\s+)?"
-            r"(?:to|into|in|towards?|inside)\s+(?P<where>.+)$"
-        ),
-    ),
     ("go_home", re.compile(rf"^{_verbs('go_home')}$")),
-    ("find", re.compile(rf"^{_verbs('find')}\s+(?P<what>.+?)$")),
-    ("pick", re.compile(rf"^{_verbs('take')}\s+(?P<what>.+?)(?:\s+up)?$")),
+    ("find", re.compile(rf"^{_verbs('find')}\s+(?P<what>(?!me\b|us\b).+?)$")),  # "find me a coke" is a bring
 ]
+# what the other clauses ask for is read as a frame (``_act``): a verb, the things, where they go
+VERB_CLASSES = ("throw_away", "clear", "release", "bring_me", "take", "put", "carry_to_surface", "go", "come")
+DESTINATION = re.compile(
+    r"\s+(?:over\s+|back\s+|down\s+)?(?:onto|on to|on top of|on|into|in to|inside|in|to|towards?|at|by|beside|"
+    r"next to|near|up to|round|around|over)\s+"
+)
+TOWARDS = re.compile(r"\s+(?:over\s+|back\s+)?(?:onto|on to|into|in to|to|towards?|over to|up to)\s+")
+LOCATING = {"from", "off", "on", "in", "at", "by", "near", "beside", "inside", "under"}  # where a thing is now
+FOR_SOMEONE = r"for (?:the kids?|him|her|them|us|me|my \w+|everyone|the team)"
+HERE = re.compile(
+    rf"\s+(?:(?:back\s+)?(?:over\s+)?(?:here|to me|to us|for me|back|over)(?:\s+{FOR_SOMEONE})?|{FOR_SOMEONE})$"
+)
+BACK = re.compile(r"\s+back\b|^back\s+")
+DOWN = re.compile(r"\s+down\b|^down\s+")
+TAKE_ONLY = {"pick up", "pick", "grasp", "hold", "lift", "collect", "snag", "nab", "grab", "take", "get"}
+BRING_ONLY = {"bring", "fetch", "deliver", "hand", "give", "pass", "send", "toss"}
 
 
 class PlanRefused(Exception):
@@ -132,44 +120,73 @@ class Question(Exception):
 
 @dataclass
 class _State:
-    """What the plan so far implies: what the robot will hold, what "it" means, spots already promised."""
+    """What the plan so far implies: what the robot will hold, where it will be, what "it" means, spots promised."""
 
     held: str | None = None
     last: list[str] = field(default_factory=list)
     spots: list[np.ndarray] = field(default_factory=list)
     steps: list[dict[str, Any]] = field(default_factory=list)
     lines: list[str] = field(default_factory=list)
+    position: np.ndarray = field(default_factory=lambda: np.zeros(2))  # where the robot will be (x, y)
+    surface: str | None = None  # the surface it was last sent to ("leave it there")
+    container: str | None = None  # the bin it was last sent to ("drop it in")
+    used: set[str] = field(default_factory=set)  # things a step has already claimed ("a drink" twice: two drinks)
+    mentioned: str = ""  # an aside that says what is wanted ("my kid wants something sweet"): for "one"
+
+    @classmethod
+    def at_start(cls, context: PlanningContext) -> _State:
+        """The robot as it is: where it stands and what it holds (it knows what is in its hand)."""
+        held = next((o for o in context.belief.present() if o.held_by is not None), None)
+        name = _name_of(held, context) if held is not None else None
+        return cls(held=name, last=[name] if name else [], position=np.asarray(context.robot_pose[:2], dtype=float))
+
+
+class NotUnderstood(PlanRefused):
+    """A clause that asks for nothing the robot knows how to do (an aside, or something it cannot do)."""
 
 
 class EmbeddedPlanner:
-    """Commands to missions by phrasing rules and grounding; asks when a phrase fits two things."""
+    """Requests to missions: clauses read as frames (verb, things, destination), things grounded in the belief."""
 
     name = "embedded"
 
-    def plan(self, text: str, context: PlanningContext) -> Plan:
+    def plan(self, text: str, context: PlanningContext, replace: tuple[str, str] | None = None) -> Plan:
         started = time.perf_counter()
-        command = normalise(text)
-        if not command:
+        clauses = read(text, known_words(context))
+        if replace is not None:
+            clauses = [_replace_phrase(clause, *replace) for clause in clauses]
+        if not clauses:
             return Plan("refusal", "I did not hear a command.")
-        state = _State()
+        state = _State.at_start(context)
+        asides: list[NotUnderstood] = []
         try:
-            for clause in split_clauses(command):
-                kind = self._clause(clause, state, context)
+            for clause in clauses:
+                try:
+                    kind = self._clause(clause, state, context)
+                except NotUnderstood as aside:
+                    asides.append(aside)  # "i knocked my drink over": kept only if nothing else is asked
+                    self._mentioned(clause, state, context)  # "the apples are soft, compost them"
+                    continue
                 if kind == "stop":
                     return Plan("stop", "Stopping.")
+            if len(asides) == len(clauses):
+                raise asides[0]
         except Question as question:
             question.choice.command = text
             return Plan("question", str(question), choice=question.choice, planning_time=time.perf_counter() - started)
         except PlanRefused as refusal:
             return Plan("refusal", str(refusal), planning_time=time.perf_counter() - started)
+        if not state.steps:  # asked for what is already so: say so, do nothing
+            state.steps.append({"say": {"text": _sentence(_join(state.lines)) if state.lines else "Done."}})
         tree = state.steps[0] if len(state.steps) == 1 else {"sequence": state.steps}
         mission = {
-            "mission": text.strip()[:120] or command,
+            "mission": text.strip()[:120] or " ".join(clauses),
             "world": context.world.name,
             "robot": context.robot,
             "tree": tree,
         }
-        summary = "I will " + _join(state.lines) + "."
+        would = re.search(r"\bhow (?:would|do|could|can|will|should) (?:you|i)\b", text.lower())
+        summary = ("I would " if would else "I will ") + _join(state.lines) + "."
         return Plan("mission", summary, mission=mission, planning_time=time.perf_counter() - started)
 
     def answer(self, choice: Choice, reply: str, context: PlanningContext) -> Plan:
@@ -178,8 +195,7 @@ class EmbeddedPlanner:
         if picked is None:
             options = " or the ".join(choice.options)
             return Plan("question", f"Sorry, which one: the {options}?", choice=choice)
-        command = normalise(choice.command)
-        return self.plan(_replace_phrase(command, choice.phrase, picked), context)
+        return self.plan(choice.command, context, replace=(choice.phrase, picked))
 
     # --- clauses -----------------------------------------------------------------
 
@@ -191,7 +207,7 @@ class EmbeddedPlanner:
             handler = getattr(self, f"_{kind}")
             handler(match, state, context)
             return kind
-        raise PlanRefused(f"I can't {clause}. I can {abilities(context)}.")
+        return self._act(clause, state, context)
 
     def _stop(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         pass
@@ -241,45 +257,221 @@ class EmbeddedPlanner:
         state.steps.append({"turn": {"object": target}})
         state.lines.append(f"turn to face the {target}")
 
-    def _bring_me(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        for target in self._objects(match["what"], state, context):
-            self._take(target, state)
-            self._give(state, context)
-
-    def _bring_to(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        where = _bare(match["where"])
-        if where in PERSON_WORDS or where in context.world.person_names:
-            self._bring_me(match, state, context)
-            return
-        self._put_on(match["what"], match["where"], state, context)
-
-    def _put(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        self._put_on(match["what"], match["where"], state, context)
-
-    def _throw_away(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        takes = BIN_VERBS.get(match.groupdict().get("verb") or "")  # "recycle": a bin for recyclable things
-        for target in self._objects(match["what"], state, context):
-            self._into(target, _bin_for(target, takes, context), state, context)
-
-    def _put_down(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        surfaces = ", the ".join(context.world.surfaces)
-        raise PlanRefused(f"Where should I put it? Say, for example, 'put it on the {surfaces}'.")
-
     def _come(self, match: re.Match, state: _State, context: PlanningContext) -> None:
         self._go_to_person(state, context)
 
-    def _go(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        where = _bare(match["where"])
-        if where in PERSON_WORDS or where in context.world.person_names:
+    def _go_home(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        self._go_to_place(_home(context), state, context)
+
+    def _find(self, match: re.Match, state: _State, context: PlanningContext) -> None:
+        for target in self._objects(match["what"], state, context):
+            state.steps.append({"find": {"object": target, "remember_as": _key(target)}})
+            state.steps.append({"say": {"text": f"I found the {target}."}})
+            state.lines.append(f"find the {target}")
+
+    # --- frames: a verb, the things it acts on, where they go ----------------------------------------------------
+
+    def _act(self, clause: str, state: _State, context: PlanningContext) -> str:
+        """A clause read as a frame; NotUnderstood when it has neither a verb the robot knows nor a thing."""
+        verb, rest = _verb_of(clause)
+        if verb is None:
+            return self._verbless(clause, state, context)
+        kinds = [kind for kind in VERB_CLASSES if verb in INTENTS[kind].verbs]
+        if verb == "drop" and re.match(r"^(?:it|them|that|those)?\s*(?:in|into|inside)\b", rest):
+            kinds.insert(0, "throw_away")  # "drop it in (the bin)"
+        tossed_to_me = verb == "toss" and re.match(r"^(?:me|us)\b", rest)
+        dropped_elsewhere = verb == "drop" and not (
+            _is_bin_phrase(rest, context) or re.match(r"^(?:it|them)?\s*in", rest)
+        )
+        if "throw_away" in kinds and not tossed_to_me and not dropped_elsewhere:
+            self._throw(verb, rest, state, context)
+            return "throw_away"
+        if "clear" in kinds:
+            self._clear(rest, state, context)
+            return "clear"
+        somewhere = not rest or re.match(
+            r"^(?:back|over|round|around|to|into|towards?|by|next|up|at|home|here|in)\b", rest
+        )
+        if ("go" in kinds or "come" in kinds) and somewhere:
+            self._go(verb, rest, state, context)
+            return "go"
+        if "release" in kinds and verb not in ("put", "set", "lay", "drop"):
+            self._transfer(verb, rest, state, context, release=True)
+            return "release"
+        if any(k in kinds for k in ("bring_me", "take", "put", "carry_to_surface", "release")):
+            self._transfer(verb, rest, state, context)
+            return "transfer"
+        if "go" in kinds:
+            self._go(verb, rest, state, context)
+            return "go"
+        raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
+
+    def _verbless(self, clause: str, state: _State, context: PlanningContext) -> str:
+        """ "rice chips to the far counter", "to the table", "a coke", "with the apple you're holding"."""
+        if is_context(clause):
+            raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
+        holding = re.match(r"^with\s+(?P<what>.+?)(?:\s+(?:you are|you're)\s+(?:holding|carrying))?$", clause)
+        if holding is not None:
+            state.last = self._objects(holding["what"], state, context)
+            return "aside"
+        stops = [_bare(p) for p in re.split(r"\s*(?:,|\band then\b|\bthen\b|\band\b)\s*", clause) if _bare(p)]
+        if stops and all(
+            _prefix_place(re.sub(r"^(?:back\s+)?to\s+", "", p), context)
+            or re.sub(r"^(?:back\s+)?to\s+", "", p) in PERSON_WORDS
+            for p in stops
+        ):
+            self._go("go", clause, state, context)  # "table, close counter, then back to me"
+            return "go"
+        if _unknown_verb(clause, context):
+            raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
+        what, where = _split_destination(clause, context, moving=True)
+        if where is not None and not what:
+            self._go("go", clause, state, context)
+            return "go"
+        if where is not None:
+            self._transfer("put", clause, state, context)
+            return "transfer"
+        if _names_a_thing(clause, context):
+            self._transfer("bring", f"me {clause}", state, context)
+            return "transfer"
+        raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
+
+    def _transfer(self, verb: str, rest: str, state: _State, context: PlanningContext, release: bool = False) -> None:
+        """Take things, and bring them to the person, put them on a surface or drop them in a bin."""
+        to_person = bool(re.match(r"^(?:me|us)\b", rest)) and verb not in ("put", "set", "place", "leave")
+        rest = re.sub(r"^(?:me|us)\s+", "", rest) if to_person else rest
+        restock = re.match(r"^(?P<where>.+?)\s+with\s+(?P<what>.+)$", rest)
+        if restock is not None and _destination(restock["where"], context) is not None:
+            rest = f"{restock['what']} on {restock['where']}"  # "restock the table with a water bottle"
+        if HERE.search(rest) and not (rest.endswith(" back") and verb not in BRING_ONLY):  # "put it back": not me
+            to_person, rest = True, HERE.sub("", rest)
+        back = bool(_back(rest, context)) or verb in ("return", "restock")
+        down = bool(DOWN.search(rest)) or release
+        rest = DOWN.sub(" ", _back(rest, context) or rest).strip()
+        moving = verb not in TAKE_ONLY  # "grab the cup on the counter" says where it is, "put it on …" where to
+        what, where = (rest, None) if to_person else _split_destination(rest, context, moving=moving)
+        beside = re.search(r"\s+(?:next to|beside|near|by|with)\s+(?P<other>.+)$", what)
+        if where is None and beside is not None:  # "put the chips next to it": on the surface that stands on
+            surface = self._surface_of(beside["other"], state, context)
+            if surface is not None:
+                what, where = what[: beside.start()].strip(), ("surface", surface)
+        if where is None and re.search(r"\s+there$", what):  # "leave them there": where the last went
+            what = re.sub(r"\s+there$", "", what)
+            where = ("surface", state.surface) if state.surface else None
+        if not what:
+            what = "it"
+        if where is not None and where[0] == "person":
+            to_person = True
+        if to_person:
+            for target in self._objects(what, state, context, bring=True):
+                self._bring(target, state, context)
+            return
+        if where is None and (down or back or verb in ("put", "set", "place", "leave", "drop", "lay")):
+            if not (down or back) and verb not in ("leave", "drop"):
+                raise PlanRefused(f"Where should I put it? Say, for example, 'put it on the {_surfaces(context)}'.")
+            targets = self._objects(what, state, context)
+            for target in targets:
+                surface = self._home_of(target, state, context) if back else self._nearest_surface(state, context)
+                self._put_on_surface(target, surface, state, context)
+            return
+        if where is None:
+            if verb in BRING_ONLY:
+                for target in self._objects(what, state, context, bring=True):
+                    self._bring(target, state, context)
+                return
+            if verb not in TAKE_ONLY and verb not in INTENTS["take"].verbs:
+                raise PlanRefused(
+                    f"Where should I take it? Say, for example, 'to the {_surfaces(context)}' or 'to me'."
+                )
+            targets = self._objects(what, state, context)
+            if len(targets) > 1:
+                raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(targets)}.")
+            self._take(targets[0], state, context)
+            return
+        kind, name = where
+        if kind == "container":
+            for target in self._objects(what, state, context):
+                self._into(target, name, state, context)
+        elif kind == "surface":
+            for target in self._objects(what, state, context):
+                self._put_on_surface(target, name, state, context)
+        else:
+            raise PlanRefused(
+                f"I can carry things to the {_surfaces(context)}, into a bin or to you, not to the {_spoken(name)}."
+            )
+
+    def _throw(self, verb: str, rest: str, state: _State, context: PlanningContext) -> None:
+        takes = BIN_VERBS.get(verb)  # "recycle": a bin for recyclable things
+        rest = re.sub(r"\s+(?:away|out)$", "", rest)
+        what, where = _split_destination(rest, context, moving=True)
+        if where is not None and where[0] != "container":  # "compost the apple on the far counter": where it is
+            what, where = rest, None
+        container = where[1] if where is not None else None
+        if not what.strip() or what.strip() in ("in", "it in", "them in"):
+            what = "it" if what.strip() in ("", "in", "it in") else "them"
+            container = container or state.container
+        for target in self._objects(what, state, context):
+            self._into(target, container or _bin_for(target, takes, context), state, context)
+
+    def _clear(self, rest: str, state: _State, context: PlanningContext) -> None:
+        """Everything believed on a surface moved off it, each to the nearest other surface with room."""
+        words = re.sub(r"^(?:everything|all|the things|things|stuff)\s+(?:off|from|on)\s+", "", rest)
+        words = re.sub(r"^(?:off|up)\s+", "", words)
+        surface = WorldVocabulary.of(context.world).surface(_bare(words))
+        if surface is None:
+            raise PlanRefused(f"I can clear a surface: the {_surfaces(context)}.")
+        on_it = [o for o in context.belief.present() if o.held_by is None and _on_surface(o, surface, context)]
+        if not on_it:
+            state.lines.append(f"find the {_spoken(surface)} already clear")
+            return
+        here = state.position
+        on_it.sort(key=lambda o: float(np.hypot(*(o.position[:2] - here))))
+        for tracked in on_it:
+            target = _name_of(tracked, context)
+            self._put_on_surface(target, self._nearest_surface(state, context, besides=surface), state, context)
+
+    def _go(self, verb: str, rest: str, state: _State, context: PlanningContext) -> None:
+        """To a place, a person or an object; to several in turn ("round every counter and back")."""
+        second, after = _verb_of(rest)
+        if second is not None and second in INTENTS["go"].verbs:  # "go park by the counter"
+            rest = after
+        rest = re.sub(
+            r"^(?:back\s+)?(?:over\s+)?(?:round|around|to|into|towards?|by|next to|up to|at|in)?\s*", "", rest
+        )
+        if not rest and verb in ("do a lap", "visit", "park", "stop by", "swing by"):
+            raise NotUnderstood(f"Where should I {verb}? I know the {_surfaces(context)}.")
+        if not rest or rest in ("back", "here", "home"):
+            if verb == "come" or rest in ("back", "here"):
+                self._go_to_person(state, context)
+            else:
+                self._go_to_place(_home(context), state, context)
+            return
+        stops = [p for p in re.split(r"\s*(?:,|\band then\b|\bthen\b|\band\b)\s*", rest) if p.strip()]
+        for words in stops:
+            self._go_one(_bare(re.sub(r"^(?:back\s+)?(?:to|round|around|by|at)\s+", "", words)), state, context)
+
+    def _go_one(self, where: str, state: _State, context: PlanningContext) -> None:
+        if where in ("back", "home", "back home", "where you started", "your start position", "start position"):
+            self._go_to_place(_home(context), state, context)
+            return
+        if where in PERSON_WORDS or where in context.world.person_names or where in ("back to me", "me again"):
             self._go_to_person(state, context)
             return
-        place = _place_name(where, context)
+        every = re.match(
+            r"^(?:every|each|all(?: the)?|all of the|the \d+|the three|the two|both)\s+(?P<kind>.+?)s?$", where
+        )
+        if every is not None:
+            places = _places_like(every["kind"], context)
+            if places:
+                for place in places:
+                    self._go_to_place(place, state, context)
+                return
+        place = _place_name(where, context) or _prefix_place(where, context)
         if place is not None:
-            state.steps.append({"navigate": {"place": place}})
-            state.lines.append(f"go to the {_spoken(place)}")
+            self._go_to_place(place, state, context)
             return
         if describes_an_object(where, list(WorldVocabulary.of(context.world).objects)):
-            target = self._one_object(match["where"], state, context)
+            target = self._one_object(where, state, context)
             key = _key(target)
             state.steps.append({"find": {"object": target, "remember_as": key}})
             state.steps.append({"navigate": {"object": f"${key}"}})
@@ -288,35 +480,28 @@ class EmbeddedPlanner:
         places = ", the ".join(_spoken(p) for p in context.world.places)
         raise PlanRefused(f"I don't know a place called '{where}'. I know the {places}.")
 
-    def _go_home(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        home = "start" if "start" in context.world.places else next(iter(context.world.places))
-        state.steps.append({"navigate": {"place": home}})
-        state.lines.append(f"go back to the {_spoken(home)}")
-
-    def _find(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        for target in self._objects(match["what"], state, context):
-            state.steps.append({"find": {"object": target, "remember_as": _key(target)}})
-            state.steps.append({"say": {"text": f"I found the {target}."}})
-            state.lines.append(f"find the {target}")
-
-    def _pick(self, match: re.Match, state: _State, context: PlanningContext) -> None:
-        targets = self._objects(match["what"], state, context)
-        if len(targets) > 1:
-            raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(targets)}.")
-        self._take(targets[0], state)
-
     # --- shared steps --------------------------------------------------------------
 
-    def _take(self, target: str, state: _State) -> None:
+    def _take(self, target: str, state: _State, context: PlanningContext) -> None:
         if state.held == target:
-            return  # already in hand from an earlier clause
+            state.lines.append(f"keep holding the {target}")
+            return  # already in hand
         if state.held is not None:
-            raise PlanRefused(f"I will be holding the {state.held}; tell me where to put it before the {target}.")
+            self._set_down(state, context)
         state.steps.append({"take": {"object": target}})
         state.lines.append(f"pick up the {target}")
         state.held = target
+        state.position = self._where_is(target, state, context)
 
-    def _give(self, state: _State, context: PlanningContext) -> None:
+    def _set_down(self, state: _State, context: PlanningContext) -> None:
+        """Free the hand: what it holds goes on the nearest surface with room."""
+        assert state.held is not None
+        last = state.last
+        self._put_on_surface(state.held, self._nearest_surface(state, context), state, context)
+        state.last = last
+
+    def _bring(self, target: str, state: _State, context: PlanningContext) -> None:
+        self._take(target, state, context)
         person = next(iter(context.world.people), None)
         if person is None:
             raise PlanRefused("There is nobody here to give it to.")
@@ -324,6 +509,7 @@ class EmbeddedPlanner:
         state.steps.append({"give": {"to": person}})
         state.lines.append("bring it to you")
         state.held = None
+        state.last = [target]
 
     def _go_to_person(self, state: _State, context: PlanningContext) -> None:
         person = next(iter(context.world.people), None)
@@ -332,67 +518,197 @@ class EmbeddedPlanner:
         state.steps.append({"navigate": {"person": person}})
         state.lines.append("come to you")
 
+    def _go_to_place(self, place: str, state: _State, context: PlanningContext) -> None:
+        state.steps.append({"navigate": {"place": place}})
+        state.lines.append(f"go to the {_spoken(place)}")
+        state.position = np.array(context.world.places[place].pose[:2], dtype=float)
+
     def _into(self, target: str, container: str, state: _State, context: PlanningContext) -> None:
         """Drop ``target`` into an open bin: carry it there if it is in hand, else take it first."""
+        bin_place = context.world.containers[container].place
         if state.held == target:
-            state.steps.append({"navigate": {"place": context.world.containers[container].place}})
+            state.steps.append({"navigate": {"place": bin_place}})
             state.steps.append({"drop": {"into": container}})
         else:
             if state.held is not None:
-                raise PlanRefused(f"I will be holding the {state.held}; I can carry one thing at a time.")
+                self._set_down(state, context)
             state.steps.append({"throw_away": {"object": target, "into": container}})
         state.lines.append(f"put the {target} in the {_spoken(container)}")
         state.held = None
         state.last = [target]
+        state.container = container
+        state.position = np.array(context.world.places[bin_place].pose[:2], dtype=float)
 
-    def _put_on(self, what: str, where: str, state: _State, context: PlanningContext) -> None:
-        words = _bare(where)
-        container = WorldVocabulary.of(context.world).container(words)
-        if container is not None:  # "put the apple in the compost"
-            for target in self._objects(what, state, context):
-                self._into(target, container, state, context)
-            return
-        surface_name = WorldVocabulary.of(context.world).surface(words) or words
-        if surface_name not in context.world.surfaces:
-            surfaces = ", the ".join(context.world.surfaces)
-            raise PlanRefused(f"I can't put things on '{surface_name}'. I can put them on the {surfaces}.")
+    def _put_on_surface(self, target: str, surface_name: str, state: _State, context: PlanningContext) -> None:
         surface = context.belief.surface(surface_name)
-        approach = np.array(context.world.places[context.world.surfaces[surface_name].place].pose[:2])
-        for target in self._objects(what, state, context):
-            spot = free_spot(surface, context.belief, approach, also_taken=state.spots)
-            if spot is None:
-                raise PlanRefused(f"There is no free spot left on the {surface_name}.")
-            state.spots.append(spot)
-            x, y = round(float(spot[0]), 3), round(float(spot[1]), 3)
-            if state.held == target:
-                state.steps.append({"navigate": {"place": context.world.surfaces[surface_name].place}})
-                state.steps.append({"place": {"surface": surface_name, "x": x, "y": y}})
-                state.lines.append(f"put it on the {surface_name}")
-            else:
-                if state.held is not None:
-                    raise PlanRefused(f"I will be holding the {state.held}; I can carry one thing at a time.")
-                state.steps.append({"fetch": {"object": target, "to": surface_name, "x": x, "y": y}})
-                state.lines.append(f"put the {target} on the {surface_name}")
-            state.held = None
-            state.last = [target]
+        place = context.world.surfaces[surface_name].place
+        approach = np.array(context.world.places[place].pose[:2])
+        spot = free_spot(surface, context.belief, approach, also_taken=state.spots)
+        if spot is None:
+            raise PlanRefused(f"There is no free spot left on the {_spoken(surface_name)}.")
+        state.spots.append(spot)
+        x, y = round(float(spot[0]), 3), round(float(spot[1]), 3)
+        if state.held == target:
+            state.steps.append({"navigate": {"place": place}})
+            state.steps.append({"place": {"surface": surface_name, "x": x, "y": y}})
+            state.lines.append(f"put it on the {_spoken(surface_name)}")
+        else:
+            if state.held is not None:
+                self._set_down(state, context)
+            state.steps.append({"fetch": {"object": target, "to": surface_name, "x": x, "y": y}})
+            state.lines.append(f"put the {target} on the {_spoken(surface_name)}")
+        state.held = None
+        state.last = [target]
+        state.surface = surface_name
+        state.position = approach
+
+    def _nearest_surface(self, state: _State, context: PlanningContext, besides: str | None = None) -> str:
+        """The surface nearest where the robot will be that has room (for putting something down)."""
+        surfaces = [s for s in context.world.surfaces if s != besides]
+        if not surfaces:
+            raise PlanRefused("There is no surface here to put things on.")
+
+        def distance(name: str) -> float:
+            return float(
+                np.hypot(
+                    *(np.array(context.world.places[context.world.surfaces[name].place].pose[:2]) - state.position)
+                )
+            )
+
+        for name in sorted(surfaces, key=distance):
+            place = context.world.surfaces[name].place
+            approach = np.array(context.world.places[place].pose[:2])
+            if free_spot(context.belief.surface(name), context.belief, approach, also_taken=state.spots) is not None:
+                return name
+        raise PlanRefused("There is no free spot left on any surface.")
+
+    def _surface_of(self, words: str, state: _State, context: PlanningContext) -> str | None:
+        """The surface a thing stands on, or was just put on by this plan ("next to it")."""
+        if _bare(words) in ("it", "that", "them", "this"):
+            return state.surface
+        try:
+            names = self._objects(words, state, context)
+        except (PlanRefused, Question):
+            return None
+        tracked = _tracked(names[0], context) if names else None
+        under = context.belief.surface_under(tracked.position) if tracked is not None else None
+        return under.name if under is not None else None
+
+    def _home_of(self, target: str, state: _State, context: PlanningContext) -> str:
+        """Where a thing was seen standing ("put it back"), else the nearest surface."""
+        tracked = _tracked(target, context)
+        if tracked is not None and tracked.held_by is None:
+            under = context.belief.surface_under(tracked.position)
+            if under is not None:
+                return under.name
+        return self._nearest_surface(state, context)
+
+    def _where_is(self, target: str, state: _State, context: PlanningContext) -> np.ndarray:
+        tracked = _tracked(target, context)
+        if tracked is None or tracked.held_by is not None:
+            return state.position
+        under = context.belief.surface_under(tracked.position)
+        if under is not None and under.name in context.world.surfaces:
+            return np.array(context.world.places[context.world.surfaces[under.name].place].pose[:2], dtype=float)
+        return np.asarray(tracked.position[:2], dtype=float)
 
     # --- objects ------------------------------------------------------------------
 
-    def _objects(self, phrase: str, state: _State, context: PlanningContext) -> list[str]:
-        """The objects a phrase names: one, or several for "all the cubes" and "them"."""
-        words = phrase.strip()
-        if re.fullmatch(r"(?:it|that|this|that one|this one)", words):
+    def _objects(self, phrase: str, state: _State, context: PlanningContext, bring: bool = False) -> list[str]:
+        """The objects a phrase names: one, several listed, a count of a kind, or every one of a kind."""
+        words = _bare(phrase.strip())
+        if re.fullmatch(r"(?:it|that|this|that one|this one|the one you are holding|what you are holding)", words):
             if not state.last:
                 raise PlanRefused("I don't know what 'it' is; name the object, for example 'the red cube'.")
             return state.last[-1:]
-        if re.fullmatch(r"(?:them|those|these|both|all of them)", words):
+        if re.fullmatch(r"(?:them|those|these|both|all of them|em|them both|both of them|the two)", words):
             if not state.last:
                 raise PlanRefused("I don't know what 'them' are; name the objects.")
             return list(state.last)
-        group = re.match(r"^(?:all(?: of)?(?: the)?|every|each|both(?: the)?|the two)\s+(?P<rest>.+)$", words)
-        targets = self._all(group["rest"], context) if group else [self._one_object(words, state, context)]
+        if state.mentioned and re.fullmatch(r"(?:one|some|one of those|one of them|something like that)", words):
+            phrase = state.mentioned  # "bring one over": one of what the aside wanted
+        wanted = read_wanted(phrase, _surface_words(context))
+        simple = len(wanted.items) == 1 and not (wanted.count or wanted.every or wanted.exclude or wanted.different)
+        if (
+            simple
+            and not self._categorical(wanted.items[0], context)
+            and _world_name_in(wanted.items[0], context) is None
+        ):
+            targets = [self._one_object(phrase, state, context)]
+        else:
+            targets = [t for item in wanted.items for t in self._choose(item, wanted, state, context)]
         state.last = targets
+        state.used |= set(targets)
         return targets
+
+    def _mentioned(self, aside: str, state: _State, context: PlanningContext) -> None:
+        """What an aside talks about becomes "it"/"them"/"one" for the clauses after it."""
+        if state.last:
+            return
+        wanted = read_wanted(re.sub(r"^(?:i|we|someone|my \w+)\s+\w+\s+", "", aside), _surface_words(context))
+        for item in wanted.items:
+            for start in range(len(item.split())):  # the thing is named somewhere in the aside
+                words = " ".join(item.split()[start:])
+                name = _world_name_in(words, context)
+                if name is not None:
+                    seen = [_name_of(o, context) for o in context.belief.present()]
+                    alike = [n for n in seen if context.world.object_of(n) == name] or [name]
+                    state.last = alike if wanted.every or re.search(r"\b(?:both|all|every)\b", aside) else alike[:1]
+                    return
+        state.mentioned = aside
+
+    def _categorical(self, item: str, context: PlanningContext) -> bool:
+        """Whether a phrase asks for things by what they are (categories, kinds) that this world's things have."""
+        return bool(_candidates(item, context))
+
+    def _choose(self, item: str, wanted: Wanted, state: _State, context: PlanningContext) -> list[str]:
+        """The things one listed item stands for: by name, or by what they are, seen ones first, nearest first."""
+        if item in ("it", "that", "this", "them", "those"):
+            return self._objects(item, state, context)
+        name = _world_name_in(item, context)
+        kinds = [name] if name is not None else _candidates(item, context)
+        if not kinds and not is_open(item):
+            if wanted.count or wanted.every:
+                raise PlanRefused(f"I don't see any {item}.")
+            return [self._one_object(item, state, context)]
+        if not kinds:
+            kinds = list(context.world.objects)  # "anything", "everything"
+        excluded = _excluded(wanted.exclude, context)
+        kinds = [k for k in kinds if k not in excluded]
+        seen = [
+            o
+            for o in context.belief.present()
+            if context.world.object_of(_name_of(o, context)) in kinds
+            and _name_of(o, context) not in excluded
+            and (wanted.source is None or _on_surface(o, wanted.source, context))
+        ]
+        here = state.position
+        seen.sort(key=lambda o: (o.held_by is None, float(np.hypot(*(o.position[:2] - here)))))
+        pool = [_name_of(o, context) for o in seen]
+        if not wanted.every:  # known to the world, not seen yet: find will look
+            pool += [k for k in kinds if not any(context.world.object_of(p) == k for p in pool)]
+        fresh = [p for p in pool if p not in state.used]
+        pool = fresh or pool
+        what = item if name is None else name
+        if wanted.every:
+            if not pool:
+                raise PlanRefused(
+                    f"I don't see any {item}{' on the ' + _spoken(wanted.source) if wanted.source else ''}."
+                )
+            return pool
+        count = wanted.count or 1
+        if wanted.different or (count > 1 and name is None):
+            distinct = {}
+            for p in pool:
+                distinct.setdefault(context.world.object_of(p), p)
+            pool = list(distinct.values()) if wanted.different else pool
+        if count == 1 and wanted.definite and not is_open(item) and name is None:
+            options = list(dict.fromkeys(context.world.object_of(p) for p in pool))
+            if len(options) > 1:  # "the caffeinated one" names one thing, and several fit: ask
+                raise Question(Choice(command="", phrase=item, options=options), _which(options))
+        if len(pool) < count:
+            raise PlanRefused(f"I know of only {len(pool)} {what}{'' if len(pool) == 1 else 's'}, not {count}.")
+        return pool[:count]
 
     def _one_object(self, phrase: str, state: _State, context: PlanningContext) -> str:
         bare = _bare(phrase)
@@ -406,6 +722,9 @@ class EmbeddedPlanner:
         if bare in context.world.surfaces or _place_name(bare, context) is not None:
             examples = ", the ".join(list(context.world.objects)[:3])
             raise PlanRefused(f"The {bare} is too big for me to carry; I can pick up things like the {examples}.")
+        alike = _same_kind(bare, context)
+        if len(alike) > 1:  # "the cube" with two cubes in the world, even if one has been seen so far
+            raise Question(Choice(command="", phrase=phrase, options=alike), _which(alike))
         belief = context.belief
         grounding = ground(phrase, belief, viewer=context.robot_pose)
         if grounding.verdict == "found" and grounding.best is not None:
@@ -426,67 +745,240 @@ class EmbeddedPlanner:
             raise Question(Choice(command="", phrase=phrase, options=named), _which(named))
         raise PlanRefused(_not_seen(bare, context))
 
-    def _all(self, phrase: str, context: PlanningContext) -> list[str]:
-        words = re.findall(r"[a-z]+", phrase)
-        kinds = {KIND_WORDS[w] for w in words if w in KIND_WORDS}
-        colours = {w for w in words if w in COLOURS}  # "all the purple cubes" are none, not every cube
-        present = context.belief.present()
-        chosen = [
-            o
-            for o in present
-            if (not kinds or o.kind in kinds) and (not colours or o.colour in colours) and (kinds or colours)
-        ]
-        if not chosen:
-            raise PlanRefused(f"I don't see any {phrase}.")
-        here = np.asarray(context.robot_pose[:2])
-        chosen.sort(key=lambda o: float(np.hypot(*(o.position[:2] - here))))
-        return [_name_of(o, context) for o in chosen]
-
 
 # --- helpers -------------------------------------------------------------------------
+
+
+def _back(words: str, context: PlanningContext) -> str | None:
+    """ "put the sponge back on the counter" without "back" (None when there is no such "back": "the back
+    counter" is a name)."""
+    for match in BACK.finditer(words):
+        after = words[match.start() :].strip()
+        if _destination(after, context) is None:
+            return (words[: match.start()] + " " + words[match.end() :]).strip()
+    return None
+
+
+def _verb_of(clause: str) -> tuple[str | None, str]:
+    """The verb a clause starts with (the longest known, "pick up" before "pick") and the words after it."""
+    for verb in _ALL_VERBS:
+        if clause == verb or clause.startswith(verb + " "):
+            return verb, clause[len(verb) :].strip()
+    return None, clause
+
+
+_ALL_VERBS = sorted({v for kind in VERB_CLASSES for v in INTENTS[kind].verbs}, key=len, reverse=True)
+
+
+_KNOWN: dict[tuple[str, int], frozenset[str]] = {}  # per world: the words requests are corrected towards
+
+
+def known_words(context: PlanningContext) -> frozenset[str]:
+    """The words a request is corrected towards (cached per world)."""
+    key = (context.world.name, id(context.world))
+    if key not in _KNOWN:
+        vocabulary = WorldVocabulary.of(context.world)
+        words = {w for intent in INTENTS.values() for verb in intent.verbs for w in verb.split()}
+        for names in (vocabulary.objects, vocabulary.places, vocabulary.surfaces, vocabulary.containers):
+            words |= {w for name in names for w in name.split()}
+        words |= {w for o in context.world.objects.values() for c in o.categories for w in c.split()}
+        words |= set(vocabulary.kinds) | set(vocabulary.plurals) | set(vocabulary.colours) | lexicon_words()
+        words |= {"me", "the", "it", "them", "and", "then", "every", "all", "both", "each", "some", "any", "something"}
+        words |= {"anything", "everything", "please", "onto", "into", "back", "down", "away", "here", "there"}
+        words |= {"one", "two", "three", "four", "five", "six", "couple", "pair", "few", "both", "different"}
+        _KNOWN[key] = frozenset(w for w in words if w.isalnum())
+    return _KNOWN[key]
+
+
+def _split_destination(
+    words: str, context: PlanningContext, moving: bool = False
+) -> tuple[str, tuple[str, str] | None]:
+    """ "the apple to the far counter" → ("the apple", ("surface", "far_counter")): the last preposition whose
+    words name a surface, a bin, a place or the person wins. For a verb that only takes ("pick up", "grab"),
+    ``moving`` is False and only "to", "onto", "into" say where to ("grab the cup on the counter" says where it
+    is); for one that moves things, "put apple far counter" (words dropped) says where too."""
+    pattern = DESTINATION if moving else TOWARDS
+    for match in reversed(list(pattern.finditer(" " + words))):
+        where = _destination(words[match.end() - 1 :], context)
+        if where is not None:
+            return words[: max(match.start() - 1, 0)].strip(), where
+    tokens = words.split()
+    if moving and not any(t in LOCATING for t in tokens):
+        for start in range(1, len(tokens)):  # dropped words: the last words name where
+            where = _destination(" ".join(tokens[start:]), context)
+            if where is not None and where[0] != "person" and _bare(" ".join(tokens[:start])):
+                return " ".join(tokens[:start]), where
+    return words, None
+
+
+def _destination(words: str, context: PlanningContext) -> tuple[str, str] | None:
+    """What some words name as a destination: the person, a surface, a bin or a place (longest name first)."""
+    bare = _bare(words)
+    bare = re.sub(r"^(?:back\s+)?(?:over\s+)?(?:to\s+)?", "", bare)
+    if bare in PERSON_WORDS or bare in context.world.person_names or bare in ("me again", "you"):
+        return ("person", next(iter(context.world.people), "person")) if bare != "you" else None
+    vocabulary = WorldVocabulary.of(context.world)
+    tokens = bare.split()
+    for end in range(len(tokens), 0, -1):  # "counter where it lives": the longest start that names something
+        head = " ".join(tokens[:end])
+        if vocabulary.container(head) is not None:
+            return ("container", vocabulary.container(head))  # type: ignore[return-value]
+        if vocabulary.surface(head) is not None:
+            return ("surface", vocabulary.surface(head))  # type: ignore[return-value]
+        if _place_name(head, context) is not None:
+            return ("place", _place_name(head, context))  # type: ignore[return-value]
+    return None
+
+
+def _unknown_verb(clause: str, context: PlanningContext) -> bool:
+    """Whether a clause starts with a verb the robot does not know ("swap the cans"), not with a thing."""
+    first = clause.split()[0]
+    if first in known_words(context) or first in ("a", "an", "the", "some", "any", "one", "to", "with", "back"):
+        return False
+    lemmas = getAllLemmas(first)
+    return ("VERB" in lemmas and "NOUN" not in lemmas) or (
+        "VERB" in lemmas and len(clause.split()) > 2 and clause.split()[1] in ("the", "a", "an", "my", "it", "them")
+    )
+
+
+def _is_bin_phrase(words: str, context: PlanningContext) -> bool:
+    where = _split_destination(words, context, moving=True)[1]
+    return where is not None and where[0] == "container"
+
+
+def _names_a_thing(words: str, context: PlanningContext) -> bool:
+    """Whether words name something to bring: a thing by name, by what it is, or an open "something to eat"."""
+    wanted = read_wanted(words, _surface_words(context))
+    return any(_world_name_in(i, context) or _candidates(i, context) or is_open(i) for i in wanted.items)
+
+
+def _world_name_in(words: str, context: PlanningContext) -> str | None:
+    """The world object whose name or alias the words contain (the longest), or None."""
+    text = f" {_canonical(words)} "
+    names = WorldVocabulary.of(context.world).objects
+    for name in sorted(names, key=len, reverse=True):
+        if f" {_canonical(name)} " in text:
+            return context.world.object_of(names[name]) or names[name]
+    return None
+
+
+def _canonical(words: str) -> str:
+    """Words with everyday variants made one: crisps are chips, a packet a bag."""
+    swaps = {"crisps": "chips", "crisp": "chip", "packet": "bag", "packets": "bags", "tin": "can"}
+    return " ".join(swaps.get(w, w) for w in words.split())
+
+
+def _candidates(item: str, context: PlanningContext) -> list[str]:
+    """The world's objects that are what a phrase says (every category, kind and colour it names fits)."""
+    world = context.world
+    categories = {c for o in world.objects.values() for c in o.categories}
+    kinds = {o.kind for o in world.objects.values()}
+    said = " ".join(KIND_WORDS.get(w, w) if KIND_WORDS.get(w) in kinds else w for w in _canonical(item).split())
+    wanted_categories, wanted_kinds = category_words(said, categories, kinds)
+    colours = {w for w in item.split() if w in COLOURS | {o.colour for o in world.objects.values()}}
+    partial = _name_words(item, context)
+    if not (wanted_categories or wanted_kinds or colours or partial):
+        return []
+    fitting = []
+    for name, declared in world.objects.items():
+        has = set(declared.categories) | {declared.kind}
+        if any(not (group & has) for group in wanted_categories):  # each word said must fit ("salty snack")
+            continue
+        if wanted_kinds and declared.kind not in wanted_kinds:
+            continue
+        if colours and declared.colour not in colours:
+            continue
+        if partial and not partial <= set(name.split()) | {w for a in declared.aliases for w in a.split()}:
+            continue
+        fitting.append(name)
+    return fitting
+
+
+def _name_words(item: str, context: PlanningContext) -> set[str]:
+    """Words of the phrase that belong to names only (not categories, kinds or colours): "the jalapeno ones"."""
+    world = context.world
+    generic = {w for o in world.objects.values() for c in [*o.categories, o.kind] for w in c.split()}
+    generic |= COLOURS | {"can", "bag", "bottle", "chip", "chips", "bar", "of", "the", "a"}
+    name_words = {w for n, o in world.objects.items() for w in [*n.split(), *(x for a in o.aliases for x in a.split())]}
+    return {w for w in _canonical(item).split() if w in name_words and w not in generic and len(w) > 2}
+
+
+def _excluded(words: str, context: PlanningContext) -> set[str]:
+    """The world objects and scene instances an exclusion names ("but the apple", "that is not fizzy")."""
+    if not words:
+        return set()
+    out = set()
+    for part in re.split(r"\s*(?:,|\band\b|\bor\b|\bnor\b)\s*", words):
+        part = _bare(part)
+        if not part:
+            continue
+        name = _world_name_in(part, context)
+        if name is not None:
+            out.add(name)
+            continue
+        out |= set(_candidates(part, context))
+    return out
+
+
+def _same_kind(bare: str, context: PlanningContext) -> list[str]:
+    """World objects a bare kind word ("cube", "the bottle") could be, when it is nothing more than that word."""
+    kind = KIND_WORDS.get(bare)
+    if kind is None:
+        return []
+    return [name for name, o in context.world.objects.items() if o.kind == kind]
+
+
+def _tracked(name: str, context: PlanningContext) -> TrackedObject | None:
+    return next((o for o in context.belief.present() if _name_of(o, context) == name), None)
+
+
+def _on_surface(tracked: TrackedObject, surface: str, context: PlanningContext) -> bool:
+    under = context.belief.surface_under(tracked.position)
+    return under is not None and under.name == surface
+
+
+def _surface_words(context: PlanningContext) -> dict[str, str]:
+    return WorldVocabulary.of(context.world).surfaces
+
+
+def _surfaces(context: PlanningContext) -> str:
+    return ", the ".join(_spoken(s) for s in context.world.surfaces)
+
+
+def _places_like(kind: str, context: PlanningContext) -> list[str]:
+    """ "every counter" → the places whose names or aliases say counter; "the three bins" → the bins'."""
+    kind = kind.rstrip("s")
+    places = []
+    for name, place in context.world.places.items():
+        words = {w for n in (_spoken(name), *place.aliases) for w in n.split()}
+        if kind in words or (kind in ("bin", "can") and name in {c.place for c in context.world.containers.values()}):
+            places.append(name)
+    return places
+
+
+def _prefix_place(words: str, context: PlanningContext) -> str | None:
+    where = _destination(words, context)
+    if where is None or where[0] == "person":
+        return None
+    if where[0] == "surface":
+        return context.world.surfaces[where[1]].place
+    if where[0] == "container":
+        return context.world.containers[where[1]].place
+    return where[1]
+
+
+def _home(context: PlanningContext) -> str:
+    return "start" if "start" in context.world.places else next(iter(context.world.places))
+
+
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:] + "."
 
 
 def is_stop(text: str) -> bool:
     """Whether a command asks the robot to stop (its first clause does): cheap enough for every typed line."""
     clauses = split_clauses(normalise(text))
     return bool(clauses) and STOP.match(clauses[0]) is not None
-
-
-def split_clauses(command: str) -> list[str]:
-    """Clauses of a normalised command: broken at commas, "and" and "then" only before a new verb.
-
-    "put the red cube and the blue cube on the shelf" stays whole; "pick up the mug and bring it to me" splits.
-    """
-    pieces: list[str] = []
-    position = 0
-    current = ""
-    for match in CLAUSE_BREAK.finditer(command):
-        after = command[match.end() :]
-        current += command[position : match.start()]
-        if STARTS_WITH_VERB.match(after) and current.strip():
-            pieces.append(current.strip())
-            current = ""
-        else:
-            current += command[match.start() : match.end()]
-        position = match.end()
-    current += command[position:]
-    if current.strip(" ,"):
-        pieces.append(current.strip(" ,"))
-    # speech drops the little words: "pick up the red cube put it on the counter" is two clauses too
-    return [part for piece in pieces if piece.strip(" ,") for part in _split_unjoined(piece.strip(" ,"))]
-
-
-UNJOINED = re.compile(r"\s(?=(?:put|place|bring|go|turn|walk|pick up|grab|find|wave|give me|hand me|come)\b)")
-
-
-def _split_unjoined(clause: str) -> list[str]:
-    """A clause broken before a second command verb (not in what a clause says aloud)."""
-    if re.match(r"^(?:say|tell|announce)\b", clause):
-        return [clause]
-    parts = [p.strip() for p in UNJOINED.split(clause) if p.strip()]
-    if any(len(p.split()) < 2 for p in parts):  # "go back", "turn around": a verb needs an object or a direction
-        return [clause]
-    return parts
 
 
 def pick_option(choice: Choice, reply: str, context: PlanningContext) -> str | None:
@@ -558,7 +1050,8 @@ def _spoken(name: str) -> str:
 def _name_of(tracked: TrackedObject, context: PlanningContext) -> str:
     """What to call an object in a mission: the world's name for it, else the robot's own id."""
     if context.world.object_of(tracked.name) is not None:  # the world's name, or a scene's ("coke 2")
-        return tracked.name
+        twins = [o for o in context.belief.present() if o.name == tracked.name and o is not tracked]
+        return tracked.id if twins else tracked.name  # two waters: each by the robot's own id
     named = [
         name
         for name, declared in context.world.objects.items()

@@ -59,19 +59,41 @@ INTENTS: dict[str, Intent] = {
     "face": Intent(
         ("face",), ("turn to face", "turn towards", "turn toward", "look towards", "look toward"), ("turn",)
     ),
-    # "bring me X": take it and give it to the person
-    "bring_me": Intent(("bring", "fetch", "give", "hand", "get"), ("pass",), ("take", "navigate", "give")),
+    # "bring me X": take it and give it to the person (these verbs with no destination mean that too)
+    "bring_me": Intent(
+        ("bring", "fetch", "give", "hand", "get"),
+        ("pass", "deliver", "send", "toss", "grab"),
+        ("take", "navigate", "give"),
+    ),
     # "carry X to the counter" (put) and "carry X to me" (bring): the same verbs when typed
     "carry_to_surface": Intent(
-        ("move", "take", "carry"), ("bring", "fetch", "get", "hand", "give", "pass"), ("fetch", "navigate", "place")
+        ("move", "take", "carry"),
+        ("bring", "fetch", "get", "hand", "give", "pass", "deliver", "relocate", "shift", "transfer", "return"),
+        ("fetch", "navigate", "place"),
     ),
     "carry_to_person": Intent(
-        ("bring", "take", "carry"), ("fetch", "get", "hand", "give", "pass", "move"), ("take", "navigate", "give")
+        ("bring", "take", "carry"),
+        ("fetch", "get", "hand", "give", "pass", "move", "deliver"),
+        ("take", "navigate", "give"),
     ),
     "bring_here": Intent((), ("bring", "fetch"), ("take", "navigate", "give")),  # "bring the mug here"
-    "put": Intent(("put", "place", "set"), ("drop", "leave", "stack"), ("fetch", "navigate", "place")),
+    "put": Intent(
+        ("put", "place", "set"),
+        ("drop", "leave", "stack", "stash", "store", "stick", "pop", "lay", "stand", "restock", "drop off", "return"),
+        ("fetch", "navigate", "place"),
+    ),
+    # "put it down", "let go of the apple": set what is in hand down on the nearest surface with room
+    "release": Intent(
+        ("put down", "set down", "release"),
+        ("lay down", "let go of", "let go", "drop", "unhand"),
+        ("navigate", "place"),
+    ),
     "come": Intent(("come here", "come to me"), ("come", "come over here", "come back", "return to me"), ("navigate",)),
-    "go": Intent(("go", "walk", "drive", "head", "navigate"), ("move", "come", "return", "get"), ("navigate", "find")),
+    "go": Intent(
+        ("go", "walk", "drive", "head", "navigate"),
+        ("move", "come", "return", "get", "park", "visit", "stop by", "swing by", "roll", "do a lap", "make your way"),
+        ("navigate", "find"),
+    ),
     "go_home": Intent(
         ("go home",), ("go back home", "come home", "come back home", "return home", "return back home"), ("navigate",)
     ),
@@ -80,12 +102,20 @@ INTENTS: dict[str, Intent] = {
         ("search for", "locate", "where's", "where are", "look at", "show me", "can you see", "do you see"),
         ("find", "say"),
     ),
-    "take": Intent(("pick up", "grab", "take", "get", "lift", "collect"), ("pick", "grasp", "hold"), ("take",)),
+    "take": Intent(
+        ("pick up", "grab", "take", "get", "lift", "collect"), ("pick", "grasp", "hold", "snag", "nab"), ("take",)
+    ),
     # "throw away the coke", "recycle the can", "compost the apple": into the bin that takes it
     "throw_away": Intent(
         ("throw away", "throw out", "recycle", "compost"),
-        ("dispose of", "get rid of", "discard", "bin", "trash", "toss", "chuck"),
+        ("dispose of", "get rid of", "discard", "bin", "trash", "toss", "chuck", "throw", "dump", "ditch"),
         ("throw_away", "navigate", "drop"),
+    ),
+    # "clear the table", "tidy up the close counter": everything on it to another surface
+    "clear": Intent(
+        (),
+        ("clear off", "clear up", "clear", "tidy up", "tidy", "empty", "clean up", "clean off", "declutter"),
+        ("fetch",),
     ),
 }
 # the bin a verb of throw_away asks for, by what the bin takes (world.yaml containers' takes:)
@@ -152,3 +182,47 @@ class WorldVocabulary:
     def object(self, words: str) -> str | None:
         """The object a name or an alias names exactly, or None (descriptions are for grounding)."""
         return self.objects.get(words)
+
+
+CLAUSE_BREAK = re.compile(r"\s*(?:,\s*)?(?:\band then\b|\bthen\b|\bafter that\b|\band\b|,)\s*")
+VERB_AT_START = re.compile("^(?:" + "|".join(re.escape(verb) for verb in every_verb()) + r")\b")
+UNJOINED = re.compile(r"\s(?=(?:put|place|bring|go|turn|walk|pick up|grab|find|wave|give me|hand me|come)\b)")
+
+
+def starts_clause(text: str) -> bool:
+    """Whether ``text`` starts with a verb of some intent: what begins a new clause after "and" or a comma."""
+    return VERB_AT_START.match(text) is not None
+
+
+def split_clauses(command: str) -> list[str]:
+    """Clauses of a normalised command: broken at commas, "and" and "then" only before a new verb.
+
+    "put the red cube and the blue cube on the shelf" stays whole; "pick up the mug and bring it to me" splits.
+    """
+    pieces: list[str] = []
+    position = 0
+    current = ""
+    for match in CLAUSE_BREAK.finditer(command):
+        after = command[match.end() :]
+        current += command[position : match.start()]
+        if starts_clause(after) and current.strip():
+            pieces.append(current.strip())
+            current = ""
+        else:
+            current += command[match.start() : match.end()]
+        position = match.end()
+    current += command[position:]
+    if current.strip(" ,"):
+        pieces.append(current.strip(" ,"))
+    # speech drops the little words: "pick up the red cube put it on the counter" is two clauses too
+    return [part for piece in pieces if piece.strip(" ,") for part in _split_unjoined(piece.strip(" ,"))]
+
+
+def _split_unjoined(clause: str) -> list[str]:
+    """A clause broken before a second command verb (not in what a clause says aloud)."""
+    if re.match(r"^(?:say|tell|announce)\b", clause):
+        return [clause]
+    parts = [p.strip() for p in UNJOINED.split(clause) if p.strip()]
+    if any(len(p.split()) < 2 for p in parts):  # "go back", "turn around": a verb needs an object or a direction
+        return [clause]
+    return parts

@@ -7,6 +7,7 @@ import numpy as np
 from bt_humanoid.perception.world_model import SupportSurface, WorldModel
 
 EDGE_DEPTH = 0.15  # m behind the near edge: well within the arm's reach, clear of the rim
+ROW_DEPTHS = (EDGE_DEPTH, 0.26, 0.34)  # m behind the near edge, tried in turn (the arm reaches 0.42: stance.py)
 CLEARANCE = 0.13  # m between the spot and the centre of anything already there
 GRID = 0.025  # m between candidate spots
 
@@ -16,29 +17,28 @@ def free_spot(
 ) -> np.ndarray | None:
     """A spot (x, y) on ``surface`` clear of the objects believed on it, reached from the edge nearest ``approach``.
 
-    Spots lie ``EDGE_DEPTH`` behind that edge; the one nearest ``approach`` wins. ``also_taken``: spots promised
-    to other things already. None if the edge is full.
+    Spots lie in rows behind that edge (``ROW_DEPTHS``): the shallowest row with room wins, and in it the spot
+    nearest ``approach``. ``also_taken``: spots promised to other things already. None if every row is full.
     """
     (x0, y0), (x1, y1) = surface.region
     ax, ay = float(approach[0]), float(approach[1])
     # the near edge: the side of the rectangle the approach point is farthest outside of
     outside = {"west": x0 - ax, "east": ax - x1, "south": y0 - ay, "north": ay - y1}
     edge = max(outside, key=outside.__getitem__)
-    if edge in ("west", "east"):
-        x = x0 + EDGE_DEPTH if edge == "west" else x1 - EDGE_DEPTH
-        ys = np.arange(y0 + EDGE_DEPTH, y1 - EDGE_DEPTH + 1e-9, GRID)
-        candidates = np.column_stack([np.full(len(ys), x), ys])
-    else:
-        y = y0 + EDGE_DEPTH if edge == "south" else y1 - EDGE_DEPTH
-        xs = np.arange(x0 + EDGE_DEPTH, x1 - EDGE_DEPTH + 1e-9, GRID)
-        candidates = np.column_stack([xs, np.full(len(xs), y)])
-    if len(candidates) == 0:
-        return None
     taken = [o.position[:2] for o in belief.present() if o.held_by is None]
     taken += list(also_taken or [])
-    if taken:
-        nearest = np.min(np.linalg.norm(candidates[:, None, :] - np.array(taken)[None, :, :], axis=2), axis=1)
-        candidates = candidates[nearest >= CLEARANCE]
-    if len(candidates) == 0:
-        return None
-    return candidates[int(np.argmin(np.linalg.norm(candidates - np.array([ax, ay]), axis=1)))]
+    for depth in ROW_DEPTHS:
+        if edge in ("west", "east"):
+            x = x0 + depth if edge == "west" else x1 - depth
+            ys = np.arange(y0 + EDGE_DEPTH, y1 - EDGE_DEPTH + 1e-9, GRID)
+            candidates = np.column_stack([np.full(len(ys), x), ys])
+        else:
+            y = y0 + depth if edge == "south" else y1 - depth
+            xs = np.arange(x0 + EDGE_DEPTH, x1 - EDGE_DEPTH + 1e-9, GRID)
+            candidates = np.column_stack([xs, np.full(len(xs), y)])
+        if taken and len(candidates):
+            nearest = np.min(np.linalg.norm(candidates[:, None, :] - np.array(taken)[None, :, :], axis=2), axis=1)
+            candidates = candidates[nearest >= CLEARANCE]
+        if len(candidates):
+            return candidates[int(np.argmin(np.linalg.norm(candidates - np.array([ax, ay]), axis=1)))]
+    return None

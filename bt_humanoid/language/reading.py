@@ -1,0 +1,185 @@
+"""Reading a request as people write it: sentences, misspellings, contractions, politeness, needs and asides.
+
+"Ugh, I knocked my drink over. Could you get me smth to mop it up pls?"
+is read as the clauses the planner acts on: ["get me something to mop it
+up"]. The steps, in order:
+
+1. plain text (``words.normalise``: lower case, digits for measured numbers),
+   accents dropped ("jalapeño"), sentences and numbered steps broken apart;
+2. contractions and chat words expanded ("i'm", "u", "pls");
+3. misspelt words corrected against the words the robot knows — its verbs,
+   the world's names, categories and places, the lexicon — when the word is
+   not English (lemminflect's lexicon) and one known word is close
+   (rapidfuzz): "wter botle" → "water bottle", "tabel" → "table";
+4. the framing around a request dropped ("would you mind …", "how would you
+   …", "… when you get a chance"), a want said as such made a request
+   ("i'd like the apple" → "bring me the apple"), a need stated made one
+   too ("i'm parched" → "bring me something to drink");
+5. clauses that only give context ("I knocked my drink over") are kept, for
+   the planner to drop when another clause asks for something.
+"""
+
+from __future__ import annotations
+
+import re
+import unicodedata
+from functools import lru_cache
+
+from lemminflect import getAllLemmas, getInflection
+from rapidfuzz import fuzz, process
+
+from bt_humanoid.language.lexicon import CATEGORY_WORDS, CONTRACTIONS, FILLERS, FRAMING, NEEDS, SLANG, WANTING
+from bt_humanoid.language.vocabulary import split_clauses, starts_clause
+from bt_humanoid.language.words import normalise
+
+SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
+STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\d+[.)]?|[a-z][.)])\s+")
+MIN_TYPO_LENGTH = 4  # shorter words are too often other words ("ot", "teh" aside)
+TYPO_SCORE = 78.0  # rapidfuzz ratio (0-100) from which a word is taken for a known one
+STATEMENT = re.compile(  # a verb that tells ("the apples are soft"), not in a relative clause ("one that is …")
+    r"(?<!that )(?<!which )(?<!who )\b(?:is|are|was|were|has|have|had|got|went|looks?|seems?|feels?)\b"
+    r"(?! (?:not )?(?:on|in)\b)"
+)
+SUBJECTS = re.compile(
+    r"^(?:i|we|my|our|it|its|there|this|that|these|those|he|she|they|someone|somebody|the kids?|your|you are)\b"
+)
+
+
+def read(text: str, known: frozenset[str]) -> list[str]:
+    """The clauses of a request, each plain and corrected; ``known``: the words the robot knows (``known_words``)."""
+    text = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode()  # jalapeño → jalapeno
+    text = text.replace("’", "'").replace("->", " -> ").replace("→", " -> ")
+    clauses = []
+    for sentence in SENTENCE_BREAK.split(" " + text.lower() + " "):
+        sentence = STEP_NUMBER.sub("", sentence.strip())
+        plain = normalise(sentence)
+        if not plain:
+            continue
+        words = [_expand(word) for word in plain.split()]
+        plain = " ".join(w for w in words if w)
+        plain = _joined(" ".join(correct(word, known) for word in plain.split()), known)
+        pieces: list[str] = []
+        for piece in re.split(r"\s*,\s*", plain):  # a comma ends a clause before a verb or an aside only
+            piece = unframe(piece)
+            if not piece:
+                continue
+            if pieces and not starts_clause(piece) and not is_context(piece) and not is_context(pieces[-1]):
+                pieces[-1] += " , " + piece
+            else:
+                pieces.append(piece)
+        clauses += [clause for piece in pieces for clause in split_clauses(piece)]
+    clauses = [unframe(clause) for clause in clauses if unframe(clause)]
+    asked = [c for c in clauses if c not in NEED_REQUESTS and not is_context(c)]
+    return [c for c in clauses if c not in NEED_REQUESTS or not asked]  # "i'm starving, bring me two snacks"
+
+
+def _joined(text: str, known: frozenset[str]) -> str:
+    """Two words that make one known word written apart ("7 up", "grape fruit") joined."""
+    words = text.split()
+    out: list[str] = []
+    for word in words:
+        if (out and out[-1] + word in known and out[-1] not in known | {"a", "the"}) or (
+            out and out[-1] + word in known and word not in known
+        ):
+            out[-1] += word
+        else:
+            out.append(word)
+    return " ".join(out)
+
+
+def _expand(word: str) -> str:
+    if word in CONTRACTIONS:
+        return CONTRACTIONS[word]
+    if word in SLANG:
+        return SLANG[word]
+    if word.endswith("'s") and len(word) > 3:
+        return word[:-2]  # "the kid's", "robot's": the owner is not the point
+    return word.replace("'", "")
+
+
+def correct(word: str, known: frozenset[str]) -> str:
+    """``word``, or the known word it is a misspelling of (see the module's docstring)."""
+    if len(word) < MIN_TYPO_LENGTH or word in known or not word.isalpha() or getAllLemmas(word):
+        return word
+    return _closest(word, known)
+
+
+@lru_cache(maxsize=4096)
+def _closest(word: str, known: frozenset[str]) -> str:
+    best = process.extractOne(word, known, scorer=fuzz.ratio, score_cutoff=TYPO_SCORE)
+    return best[0] if best is not None else word
+
+
+FRAMING_AT_START = re.compile(
+    r"^(?:" + "|".join(re.escape(f) for f in sorted(FRAMING, key=len, reverse=True)) + r")\b\s*"
+)
+FRAMING_AT_END = re.compile(
+    r"\s*\b(?:" + "|".join(re.escape(f) for f in sorted(FRAMING, key=len, reverse=True)) + r")$"
+)
+FILLER_AT_START = re.compile(
+    r"^(?:" + "|".join(re.escape(f) for f in sorted(FILLERS, key=len, reverse=True)) + r")\b\s*"
+)
+WANT_AT_START = re.compile(r"^(?:" + "|".join(re.escape(w) for w in sorted(WANTING, key=len, reverse=True)) + r")\b\s*")
+NEED_REQUESTS = {f"bring me {wanted}" for wanted in NEEDS.values()}
+WOULD_BE = re.compile(
+    r"^(?P<what>(?:some|a|an|something|anything)\b.*?)\s+(?:would|will|could)\s+(?:be|do|hit the spot)\b.*$"
+)
+NEED = re.compile(
+    r"^(?:i am|we are|i feel|feeling|i get|getting)\s+(?:so\s+|really\s+|absolutely\s+|a bit\s+|kinda\s+)*(?P<need>"
+    + "|".join(NEEDS)
+    + r")\b"
+)
+
+
+def unframe(clause: str) -> str:
+    """A clause without the words around what it asks ("could you please …", "… for me"); a want or a need as a
+    request to bring something."""
+    previous = None
+    while clause != previous:
+        previous = clause
+        clause = FILLER_AT_START.sub("", clause).strip()
+        clause = FRAMING_AT_START.sub("", clause).strip()
+        if not re.match(r"^(?:say|tell|announce)\b", clause):  # what is to be said stays as it is
+            clause = FRAMING_AT_END.sub("", clause).strip()
+    would = WOULD_BE.match(clause)
+    if would is not None:
+        return f"bring me {would['what']}"
+    need = NEED.match(clause)
+    if need is not None:
+        return f"bring me {NEEDS[need['need']]}"
+    wanted = WANT_AT_START.match(clause)
+    if wanted is not None and clause[wanted.end() :].strip():
+        rest = clause[wanted.end() :].strip()
+        rest = re.sub(r"^(?:you to|to have|to)\s+", "", rest)
+        return rest if _starts_with_verb_like(rest) else f"bring me {rest}"
+    return _gerund(clause)
+
+
+def _starts_with_verb_like(text: str) -> bool:
+    first = text.split()[0] if text else ""
+    return "VERB" in getAllLemmas(first) and "NOUN" not in getAllLemmas(first)
+
+
+def _gerund(clause: str) -> str:
+    """ "grabbing the coke" (after "would you mind") → "grab the coke"."""
+    first, _, rest = clause.partition(" ")
+    if first.endswith("ing") and len(first) > 4:
+        lemmas = getAllLemmas(first).get("VERB")
+        if lemmas:
+            return f"{lemmas[0]} {rest}".strip()
+    return clause
+
+
+def is_context(clause: str) -> bool:
+    """A clause that tells something rather than asks: "i knocked my drink over", "the apples are soft",
+    "got a meeting in five"."""
+    if SUBJECTS.match(clause) is not None or STATEMENT.search(clause) is not None:
+        return True
+    first = clause.split()[0] if clause else ""
+    lemma = getAllLemmas(first).get("VERB", ("",))[0]
+    return bool(lemma) and first != lemma and getInflection(lemma, "VBD") == (first,)  # "knocked", "got", "left"
+
+
+def lexicon_words() -> set[str]:
+    """The lexicon's words, for ``known``: what a misspelling may be corrected to."""
+    return {word for phrase in CATEGORY_WORDS for word in phrase.split()}
