@@ -208,7 +208,7 @@ def _plan_from_command(args: argparse.Namespace, console: Console, stack):  # st
     ask questions of ``--answer`` or the user."""
     import yaml
 
-    from bt_humanoid.commanding import plan_command
+    from bt_humanoid.commanding import plan_from_here
 
     if not args.command.strip():
         raise UserError("--command is empty", hint='say what to do, e.g. --command "pick up the red cube"')
@@ -223,9 +223,7 @@ def _plan_from_command(args: argparse.Namespace, console: Console, stack):  # st
             console.print(f"[bold]you:[/] {reply}", highlight=False)
         return reply
 
-    planner = _planner(args)
-    stack.look()
-    outcome = plan_command(args.command, stack.planning_context(), answer, planner)
+    outcome = plan_from_here(stack, args.command, answer, _planner(args))
     plan = outcome.plan
     if plan.kind == "mission":
         console.print(f"[bold]robot:[/] {plan.say}", highlight=False)

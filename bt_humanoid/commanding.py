@@ -8,6 +8,7 @@ never from the simulator; the planned mission then runs on that same stack.
 from __future__ import annotations
 
 import queue
+import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -39,21 +40,39 @@ MAX_QUESTIONS = 3  # answers taken per command; still unclear after them, the qu
 class CommandOutcome:
     plan: Plan  # the last answer of the planner
     spec: MissionSpec | None  # the validated mission, when there is one to run
+    seconds: float = 0.0  # wall time from text to validated mission (questions' answers included)
 
 
 def look_around(stack: RobotStack) -> None:
-    """Look ahead, left and right with the head (as ``find`` does), then ahead again: what a person glances at
-    before answering a request, so that the planner knows what stands beside the robot, not only in front.
-    Real head motion in physics (a few seconds of simulated time); a robot without a panning head looks once."""
+    """Look left and right with the head (as ``find`` does), then turn once round on the spot: what a person
+    does before answering "recycle all the cans", so that the planner knows what stands around the robot, not
+    only in front of it. Real motion in physics (about 10 s of simulated time, the camera looking all the while);
+    a robot without a panning head only looks once."""
     pan = stack.robot_config.head_pan
     stack.look()
     if pan is None or stack.perceiver is None:
         return
     turns = [{"move_joints": {"joints": {pan: angle}}} for angle in (*LOOK_AROUND[1:], 0.0)]
+    turns.append({"rotate_in_place": {"angle": 360.0}})
     glance = {"mission": "look around", "world": stack.world.name, "robot": stack.robot_config.name}
     spec = MissionLoader.for_plans().load_data({**glance, "tree": {"sequence": turns}}, name="<look around>")
     MissionRun(stack, spec).execute()
     stack.look()
+
+
+def plan_from_here(
+    stack: RobotStack,
+    text: str,
+    answers: Callable[[str], str | None],
+    planner: EmbeddedPlanner | LlmPlanner | None = None,
+) -> CommandOutcome:
+    """Plan ``text`` on ``stack`` as a person would answer it: one look first; when the answer depends on what
+    is around ("recycle all the cans", "bring me a drink"), look around and plan again from what was seen."""
+    stack.look()
+    first = EmbeddedPlanner().plan(text, stack.planning_context())  # offline and quick, whatever plans after
+    if first.involves_things():
+        look_around(stack)
+    return plan_command(text, stack.planning_context(), answers, planner)
 
 
 def make_planner(settings: LlmSettings | None) -> EmbeddedPlanner | LlmPlanner:
@@ -118,6 +137,7 @@ def plan_command(
     """
     if is_unclear(text):
         return CommandOutcome(Plan("refusal", "I could not make out all the words. Please say it another way."), None)
+    started = time.perf_counter()
     planner = planner or EmbeddedPlanner()
     plan = planner.plan(text, context)
     for _ in range(MAX_QUESTIONS):
@@ -130,7 +150,7 @@ def plan_command(
     spec = None
     if plan.kind == "mission" and plan.mission is not None:
         spec = MissionLoader.for_plans().load_data(plan.mission, name="<command>")
-    return CommandOutcome(plan, spec)
+    return CommandOutcome(plan, spec, time.perf_counter() - started)
 
 
 def ask_before_giving_up(spec: MissionSpec) -> MissionSpec:

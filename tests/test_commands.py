@@ -13,6 +13,7 @@ from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.testing.told import told_planning_context
 
 
+@pytest.mark.sim  # bt-plan looks around before planning a request about things: physics
 def test_bt_plan_prints_the_mission_it_would_run(capsys):
     assert plan_main(["pick up the red cube and put it on the counter"]) == EXIT_OK
     out = capsys.readouterr().out
@@ -20,12 +21,14 @@ def test_bt_plan_prints_the_mission_it_would_run(capsys):
     assert "- take:\n      object: red cube" in out and "surface: counter" in out
 
 
+@pytest.mark.sim  # bt-plan looks around before planning a request about things: physics
 def test_bt_plan_refuses_what_it_cannot_do_with_exit_2(capsys):
     assert plan_main(["do a backflip"]) == EXIT_INVALID
     err = capsys.readouterr().err
     assert "command 'do a backflip' not understood: I can't do a backflip. I can go to a place" in err
 
 
+@pytest.mark.sim  # bt-plan looks around before planning a request about things: physics
 def test_bt_plan_asks_and_takes_the_answer_from_the_command_line(capsys):
     # from the start the robot sees a blue cube and a blue bottle on the table
     assert plan_main(["grab the blue thing"]) == EXIT_INVALID  # a question, and nobody to answer it

@@ -45,8 +45,11 @@ def test_a_coke_among_three_alike_is_any_of_them_not_a_question():
         outcome = plan_command("bring me a coke", stack.planning_context(), lambda question: None)
         assert outcome.spec is not None, outcome.plan.say
         assert outcome.plan.mission["tree"]["sequence"][0] == {"take": {"object": "coke"}}
-        asked = plan_command("bring me a can", stack.planning_context(), lambda question: None)
-        assert asked.plan.kind == "question"  # cans that differ: which one is a fair question
+        asked = plan_command("bring me the can", stack.planning_context(), lambda question: None)
+        assert asked.plan.kind == "question"  # "the can", and cans that differ: which one is a fair question
+        any_can = plan_command("bring me a can", stack.planning_context(), lambda question: None)
+        taken = any_can.plan.mission["tree"]["sequence"][0]["take"]["object"]  # "a can": any will do, it says which
+        assert taken in ("coke", "pepsi", "7up") and f"the {taken}" in any_can.plan.say
     finally:
         stack.close()
 

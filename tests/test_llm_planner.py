@@ -196,6 +196,7 @@ def test_the_world_summary_is_what_the_robot_believes(context):
     assert summary["other_names"]["kitchen counter"] == "counter"  # world.yaml's aliases, with what they name
 
 
+@pytest.mark.sim  # bt-plan looks around before planning a request about things: physics
 def test_bt_plan_uses_the_endpoint_given_on_the_command_line(model, capsys):
     model.answers(GOOD)
     code = plan_main(["bring the mug", "--llm-url", model.url, "--llm-model", "scripted"])

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from bt_humanoid.commanding import look_around, plan_command
+from bt_humanoid.commanding import plan_from_here
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.evaluation.goals import (
@@ -57,12 +57,10 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
         "fault": None,
     }
     try:
-        look_around(stack)
         catalogue = Catalogue.of_scene(world, scene)
         start = scene_situation(scene, world)
-        clock = time.perf_counter()
-        outcome = plan_command(instruction.say, stack.planning_context(), lambda question: None)
-        figures: dict[str, Any] = {"plan_ms": [round((time.perf_counter() - clock) * 1000, 2)], "stop_latency_s": None}
+        outcome = plan_from_here(stack, instruction.say, lambda question: None)
+        figures: dict[str, Any] = {"plan_ms": [round(outcome.seconds * 1000, 2)], "stop_latency_s": None}
         plan = outcome.plan
         record["plan"] = plan.say
         record["plan_failure"] = _judge_plan(plan, start, catalogue, world, instruction.expect, _instances(stack))

@@ -26,10 +26,11 @@ from __future__ import annotations
 import re
 import time
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
-from lemminflect import getAllLemmas
+from lemminflect import getAllLemmas, getLemma
 
 from bt_humanoid.language.phrases import Wanted, category_words, is_open, read_wanted
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
@@ -175,7 +176,8 @@ class EmbeddedPlanner:
             question.choice.command = text
             return Plan("question", str(question), choice=question.choice, planning_time=time.perf_counter() - started)
         except PlanRefused as refusal:
-            return Plan("refusal", str(refusal), planning_time=time.perf_counter() - started)
+            understood = not isinstance(refusal, NotUnderstood)
+            return Plan("refusal", str(refusal), planning_time=time.perf_counter() - started, understood=understood)
         if not state.steps:  # asked for what is already so: say so, do nothing
             state.steps.append({"say": {"text": _sentence(_join(state.lines)) if state.lines else "Done."}})
         tree = state.steps[0] if len(state.steps) == 1 else {"sequence": state.steps}
@@ -324,6 +326,11 @@ class EmbeddedPlanner:
             return "go"
         if _unknown_verb(clause, context):
             raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
+        parts = [p for p in re.split(r"\s*,\s*", clause) if p]
+        if len(parts) > 1 and all(_split_destination(p, context, moving=True)[1] for p in parts):
+            for part in parts:  # "red bull onto the table, apple onto the far counter"
+                self._verbless(part, state, context)
+            return "transfer"
         what, where = _split_destination(clause, context, moving=True)
         if where is not None and not what:
             self._go("go", clause, state, context)
@@ -350,7 +357,7 @@ class EmbeddedPlanner:
         rest = DOWN.sub(" ", _back(rest, context) or rest).strip()
         moving = verb not in TAKE_ONLY  # "grab the cup on the counter" says where it is, "put it on …" where to
         what, where = (rest, None) if to_person else _split_destination(rest, context, moving=moving)
-        beside = re.search(r"\s+(?:next to|beside|near|by|with)\s+(?P<other>.+)$", what)
+        beside = re.search(r"\s+(?:next to|beside|near|by)\s+(?P<other>.+)$", what)
         if where is None and beside is not None:  # "put the chips next to it": on the surface that stands on
             surface = self._surface_of(beside["other"], state, context)
             if surface is not None:
@@ -458,7 +465,8 @@ class EmbeddedPlanner:
             self._go_to_person(state, context)
             return
         every = re.match(
-            r"^(?:every|each|all(?: the)?|all of the|the \d+|the three|the two|both)\s+(?P<kind>.+?)s?$", where
+            r"^(?:every|each|all(?: the)?|all of the|(?:the )?(?:\d+|two|three|four|five|six)|both)\s+(?P<kind>.+?)s?$",
+            where,
         )
         if every is not None:
             places = _places_like(every["kind"], context)
@@ -651,11 +659,12 @@ class EmbeddedPlanner:
                 words = " ".join(item.split()[start:])
                 name = _world_name_in(words, context)
                 if name is not None:
-                    seen = [_name_of(o, context) for o in context.belief.present()]
-                    alike = [n for n in seen if context.world.object_of(n) == name] or [name]
+                    seen = [o for o in context.belief.present() if _world_object(o, context) == name]
+                    alike = [_name_of(o, context) for o in seen] or [name]
                     state.last = alike if wanted.every or re.search(r"\b(?:both|all|every)\b", aside) else alike[:1]
                     return
-        state.mentioned = aside
+        wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
+        state.mentioned = wanting.group(0) if wanting else ""  # "my kid wants something sweet": "something sweet"
 
     def _categorical(self, item: str, context: PlanningContext) -> bool:
         """Whether a phrase asks for things by what they are (categories, kinds) that this world's things have."""
@@ -678,15 +687,19 @@ class EmbeddedPlanner:
         seen = [
             o
             for o in context.belief.present()
-            if context.world.object_of(_name_of(o, context)) in kinds
-            and _name_of(o, context) not in excluded
+            if _world_object(o, context) in kinds
+            and _world_object(o, context) not in excluded
             and (wanted.source is None or _on_surface(o, wanted.source, context))
         ]
         here = state.position
         seen.sort(key=lambda o: (o.held_by is None, float(np.hypot(*(o.position[:2] - here)))))
-        pool = [_name_of(o, context) for o in seen]
+        specific = wanted.every or wanted.count or wanted.source is not None  # which one matters: by its id
+        pool = [_one_of(o, context) if specific else _name_of(o, context) for o in seen]
+        of = {name: _world_object(o, context) for name, o in zip(pool, seen, strict=True)}
         if not wanted.every:  # known to the world, not seen yet: find will look
-            pool += [k for k in kinds if not any(context.world.object_of(p) == k for p in pool)]
+            unseen = [k for k in kinds if k not in of.values()]
+            pool += unseen
+            of |= {k: k for k in unseen}
         fresh = [p for p in pool if p not in state.used]
         pool = fresh or pool
         what = item if name is None else name
@@ -700,10 +713,10 @@ class EmbeddedPlanner:
         if wanted.different or (count > 1 and name is None):
             distinct = {}
             for p in pool:
-                distinct.setdefault(context.world.object_of(p), p)
+                distinct.setdefault(of[p], p)
             pool = list(distinct.values()) if wanted.different else pool
         if count == 1 and wanted.definite and not is_open(item) and name is None:
-            options = list(dict.fromkeys(context.world.object_of(p) for p in pool))
+            options = list(dict.fromkeys(of[p] for p in pool))
             if len(options) > 1:  # "the caffeinated one" names one thing, and several fit: ask
                 raise Question(Choice(command="", phrase=item, options=options), _which(options))
         if len(pool) < count:
@@ -814,9 +827,14 @@ def _split_destination(
 def _destination(words: str, context: PlanningContext) -> tuple[str, str] | None:
     """What some words name as a destination: the person, a surface, a bin or a place (longest name first)."""
     bare = _bare(words)
-    bare = re.sub(r"^(?:back\s+)?(?:over\s+)?(?:to\s+)?", "", bare)
+    if _destination_named(bare, context) is None:  # "back to the table" (but "the back counter" is a name)
+        bare = re.sub(r"^(?:back\s+)?(?:over\s+)?(?:to\s+)?", "", bare)
     if bare in PERSON_WORDS or bare in context.world.person_names or bare in ("me again", "you"):
         return ("person", next(iter(context.world.people), "person")) if bare != "you" else None
+    return _destination_named(bare, context)
+
+
+def _destination_named(bare: str, context: PlanningContext) -> tuple[str, str] | None:
     vocabulary = WorldVocabulary.of(context.world)
     tokens = bare.split()
     for end in range(len(tokens), 0, -1):  # "counter where it lives": the longest start that names something
@@ -853,8 +871,12 @@ def _names_a_thing(words: str, context: PlanningContext) -> bool:
 
 
 def _world_name_in(words: str, context: PlanningContext) -> str | None:
-    """The world object whose name or alias the words contain (the longest), or None."""
+    """The world object whose name or alias the words contain (the longest), or None. A category of several
+    words is not a name: "sparkling waters" are not the water bottle."""
     text = f" {_canonical(words)} "
+    for category in sorted({c for o in context.world.objects.values() for c in o.categories}, key=len, reverse=True):
+        if " " in category:
+            text = text.replace(f" {_canonical(category)} ", " ")
     names = WorldVocabulary.of(context.world).objects
     for name in sorted(names, key=len, reverse=True):
         if f" {_canonical(name)} " in text:
@@ -863,9 +885,14 @@ def _world_name_in(words: str, context: PlanningContext) -> str | None:
 
 
 def _canonical(words: str) -> str:
-    """Words with everyday variants made one: crisps are chips, a packet a bag."""
-    swaps = {"crisps": "chips", "crisp": "chip", "packet": "bag", "packets": "bags", "tin": "can"}
-    return " ".join(swaps.get(w, w) for w in words.split())
+    """Words in one form: singular ("apples" → "apple"), and everyday variants made one (crisps are chips)."""
+    swaps = {"crisp": "chip", "crisps": "chip", "packet": "bag", "tin": "can"}
+    return " ".join(swaps.get(_singular(w), _singular(w)) for w in words.split())
+
+
+@lru_cache(maxsize=4096)
+def _singular(word: str) -> str:
+    return getLemma(word, "NOUN")[0] if word.isalpha() and word.endswith("s") else word
 
 
 def _candidates(item: str, context: PlanningContext) -> list[str]:
@@ -1050,14 +1077,26 @@ def _spoken(name: str) -> str:
 def _name_of(tracked: TrackedObject, context: PlanningContext) -> str:
     """What to call an object in a mission: the world's name for it, else the robot's own id."""
     if context.world.object_of(tracked.name) is not None:  # the world's name, or a scene's ("coke 2")
-        twins = [o for o in context.belief.present() if o.name == tracked.name and o is not tracked]
-        return tracked.id if twins else tracked.name  # two waters: each by the robot's own id
+        return tracked.name
     named = [
         name
         for name, declared in context.world.objects.items()
         if (declared.kind, declared.colour) == (tracked.kind, tracked.colour)
     ]
     return named[0] if len(named) == 1 else tracked.id
+
+
+def _one_of(tracked: TrackedObject, context: PlanningContext) -> str:
+    """A believed object by a name only it has: the robot's own id when another one looks the same ("both
+    apples", "the apple on the far counter"), else its name."""
+    name = _name_of(tracked, context)
+    twins = [o for o in context.belief.present() if o is not tracked and _name_of(o, context) == name]
+    return tracked.id if twins else name
+
+
+def _world_object(tracked: TrackedObject, context: PlanningContext) -> str | None:
+    """The world object a believed one is (whatever the plan calls it)."""
+    return context.world.object_of(tracked.name) or context.world.object_of(_name_of(tracked, context))
 
 
 def _by_vocabulary(words: str, context: PlanningContext) -> list[str]:

@@ -36,6 +36,26 @@ class Plan:
     mission: dict[str, Any] | None = None
     choice: Choice | None = None  # for a question
     planning_time: float = 0.0  # s of wall time from text to this plan
+    understood: bool = True  # False for a refusal of words the planner could not read as any request
+
+    def involves_things(self) -> bool:
+        """Whether the answer depends on what the robot sees: a mission that handles objects, a question, or a
+        refusal of a request it understood ("I don't see a banana")."""
+        if self.kind == "mission" and self.mission is not None:
+            return bool(OBJECT_STEPS & _kinds(self.mission["tree"]))
+        return self.kind == "question" or (self.kind == "refusal" and self.understood)
+
+
+OBJECT_STEPS = {"take", "fetch", "throw_away", "find", "give", "place", "drop", "pick", "turn"}
+
+
+def _kinds(node: Any) -> set[str]:
+    """Every node kind in a mission tree."""
+    if isinstance(node, list):
+        return {k for child in node for k in _kinds(child)}
+    if not isinstance(node, dict):
+        return set()
+    return set(node) | {k for value in node.values() for k in _kinds(value)}
 
 
 def plan_outcome(plan: Plan) -> dict[str, Any]:
