@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from lemminflect import getAllLemmas, getLemma
 
-from bt_humanoid.language.phrases import Wanted, category_words, is_open, read_wanted
+from bt_humanoid.language.phrases import Item, Wanted, category_words, is_open, read_wanted
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
 from bt_humanoid.language.reading import is_context, lexicon_words, read
 from bt_humanoid.language.vocabulary import BIN_VERBS, INTENTS, WorldVocabulary, split_clauses
@@ -55,7 +55,7 @@ def abilities(context: PlanningContext) -> str:
 DEFAULT_TURN = 90.0  # degrees for "turn left" without a number
 DEFAULT_STEP = 1.0  # m for "walk forward" without a number
 MAX_STEP = 5.0  # m: a longer relative move is a job for "go to"
-PERSON_WORDS = {"me", "us", "the user", "user", "the person", "person", "here"}
+PERSON_WORDS = {"me", "us", "the user", "user", "the person", "person", "here", "where i am", "where we are"}
 ARTICLE = re.compile(r"^(?:the|a|an|some|my|your|that|this)\s+")
 
 
@@ -101,11 +101,17 @@ TOWARDS = re.compile(r"\s+(?:over\s+|back\s+)?(?:onto|on to|into|in to|to|toward
 LOCATING = {"from", "off", "on", "in", "at", "by", "near", "beside", "inside", "under"}  # where a thing is now
 FOR_SOMEONE = r"for (?:the kids?|him|her|them|us|me|my \w+|everyone|the team)"
 HERE = re.compile(
-    rf"\s+(?:(?:back\s+)?(?:over\s+)?(?:here|to me|to us|for me|back|over)(?:\s+{FOR_SOMEONE})?|{FOR_SOMEONE})$"
+    rf"\s+(?:(?:back\s+)?(?:over\s+)?(?:here|to me|to us|for me|with me|with us|back|over|to where i am)"
+    rf"(?:\s+{FOR_SOMEONE})?|{FOR_SOMEONE})$"
 )
 BACK = re.compile(r"\s+back\b|^back\s+")
 DOWN = re.compile(r"\s+down\b|^down\s+")
 TAKE_ONLY = {"pick up", "pick", "grasp", "hold", "lift", "collect", "snag", "nab", "grab", "take", "get"}
+TAKE_ONLY |= {"hold on to", "hang on to", "keep hold of", "take hold of", "keep"}
+HELD_PHRASE = re.compile(
+    r"^(?:(?:the )?(?:thing|one|object|stuff)? ?(?:in|from) your hand|(?:the )?(?:thing |one )?(?:that )?"
+    r"(?:what )?you (?:are )?(?:holding|carrying|have)|what you have|what is in your hand)$"
+)
 BRING_ONLY = {"bring", "fetch", "deliver", "hand", "give", "pass", "send", "toss"}
 
 
@@ -133,6 +139,8 @@ class _State:
     container: str | None = None  # the bin it was last sent to ("drop it in")
     used: set[str] = field(default_factory=set)  # things a step has already claimed ("a drink" twice: two drinks)
     mentioned: str = ""  # an aside that says what is wanted ("my kid wants something sweet"): for "one"
+    pending: list[str] = field(default_factory=list)  # "grab every can (and bin them)": taken by the next clause
+    done: dict[str, tuple[str, str]] = field(default_factory=dict)  # where this plan has already put things
 
     @classmethod
     def at_start(cls, context: PlanningContext) -> _State:
@@ -172,6 +180,8 @@ class EmbeddedPlanner:
                     return Plan("stop", "Stopping.")
             if len(asides) == len(clauses):
                 raise asides[0]
+            if state.pending:
+                raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(state.pending)}.")
         except Question as question:
             question.choice.command = text
             return Plan("question", str(question), choice=question.choice, planning_time=time.perf_counter() - started)
@@ -288,9 +298,16 @@ class EmbeddedPlanner:
         if "throw_away" in kinds and not tossed_to_me and not dropped_elsewhere:
             self._throw(verb, rest, state, context)
             return "throw_away"
-        if "clear" in kinds:
+        if "clear" in kinds and (
+            not rest or _destination(re.sub(r"^(?:off|up|everything off|all)\s+", "", rest), context)
+        ):
             self._clear(rest, state, context)
             return "clear"
+        if "clear" in kinds:  # "tidy the chips away (onto the counter)": put it away, or back where it belongs
+            rest = re.sub(r"\s+(?:away|up)\b", "", rest)
+            what, where = _split_destination(rest, context, moving=True)
+            self._transfer("put", rest if where else f"{rest} back", state, context)
+            return "transfer"
         somewhere = not rest or re.match(
             r"^(?:back|over|round|around|to|into|towards?|by|next|up|at|home|here|in)\b", rest
         )
@@ -352,7 +369,9 @@ class EmbeddedPlanner:
             rest = f"{restock['what']} on {restock['where']}"  # "restock the table with a water bottle"
         if HERE.search(rest) and not (rest.endswith(" back") and verb not in BRING_ONLY):  # "put it back": not me
             to_person, rest = True, HERE.sub("", rest)
-        back = bool(_back(rest, context)) or verb in ("return", "restock")
+        away = re.search(r"\s+away$", rest) is not None and verb not in INTENTS["throw_away"].verbs  # "put it away"
+        rest = re.sub(r"\s+away$", "", rest) if away else rest
+        back = bool(_back(rest, context)) or verb in ("return", "restock") or away
         down = bool(DOWN.search(rest)) or release
         rest = DOWN.sub(" ", _back(rest, context) or rest).strip()
         moving = verb not in TAKE_ONLY  # "grab the cup on the counter" says where it is, "put it on …" where to
@@ -370,7 +389,9 @@ class EmbeddedPlanner:
         if where is not None and where[0] == "person":
             to_person = True
         if to_person:
-            for target in self._objects(what, state, context, bring=True):
+            targets = self._objects(what, state, context, bring=True)
+            targets.sort(key=lambda t: t != state.held)  # what is in hand first: it is on its way already
+            for target in targets:
                 self._bring(target, state, context)
             return
         if where is None and (down or back or verb in ("put", "set", "place", "leave", "drop", "lay")):
@@ -391,9 +412,10 @@ class EmbeddedPlanner:
                     f"Where should I take it? Say, for example, 'to the {_surfaces(context)}' or 'to me'."
                 )
             targets = self._objects(what, state, context)
-            if len(targets) > 1:
-                raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(targets)}.")
-            self._take(targets[0], state, context)
+            if len(targets) > 1:  # one hand: wait for where they go ("… and bin them"), else refused at the end
+                state.pending = targets
+                return
+            self._take(targets[0], state, context, asked=True)
             return
         kind, name = where
         if kind == "container":
@@ -475,6 +497,15 @@ class EmbeddedPlanner:
                     self._go_to_place(place, state, context)
                 return
         place = _place_name(where, context) or _prefix_place(where, context)
+        if place is None and where.endswith("s"):  # "head over to the bins": the nearest of them
+            alike = _places_like(where, context)
+            place = (
+                min(
+                    alike, key=lambda p: float(np.hypot(*(np.array(context.world.places[p].pose[:2]) - state.position)))
+                )
+                if alike
+                else None
+            )
         if place is not None:
             self._go_to_place(place, state, context)
             return
@@ -490,9 +521,10 @@ class EmbeddedPlanner:
 
     # --- shared steps --------------------------------------------------------------
 
-    def _take(self, target: str, state: _State, context: PlanningContext) -> None:
+    def _take(self, target: str, state: _State, context: PlanningContext, asked: bool = False) -> None:
         if state.held == target:
-            state.lines.append(f"keep holding the {target}")
+            if asked:
+                state.lines.append(f"keep holding the {target}")
             return  # already in hand
         if state.held is not None:
             self._set_down(state, context)
@@ -534,6 +566,8 @@ class EmbeddedPlanner:
     def _into(self, target: str, container: str, state: _State, context: PlanningContext) -> None:
         """Drop ``target`` into an open bin: carry it there if it is in hand, else take it first."""
         bin_place = context.world.containers[container].place
+        if state.done.get(target) == ("inside", container):  # "carry it to the bin and throw it in": once
+            return
         if state.held == target:
             state.steps.append({"navigate": {"place": bin_place}})
             state.steps.append({"drop": {"into": container}})
@@ -544,10 +578,13 @@ class EmbeddedPlanner:
         state.lines.append(f"put the {target} in the {_spoken(container)}")
         state.held = None
         state.last = [target]
+        state.done[target] = ("inside", container)
         state.container = container
         state.position = np.array(context.world.places[bin_place].pose[:2], dtype=float)
 
     def _put_on_surface(self, target: str, surface_name: str, state: _State, context: PlanningContext) -> None:
+        if state.done.get(target) == ("on", surface_name):  # "take it to the table and leave it there": once
+            return
         surface = context.belief.surface(surface_name)
         place = context.world.surfaces[surface_name].place
         approach = np.array(context.world.places[place].pose[:2])
@@ -559,7 +596,8 @@ class EmbeddedPlanner:
         if state.held == target:
             state.steps.append({"navigate": {"place": place}})
             state.steps.append({"place": {"surface": surface_name, "x": x, "y": y}})
-            state.lines.append(f"put it on the {_spoken(surface_name)}")
+            just_taken = bool(state.lines) and state.lines[-1].endswith(f"the {target}")
+            state.lines.append(f"put {'it' if just_taken else 'the ' + target} on the {_spoken(surface_name)}")
         else:
             if state.held is not None:
                 self._set_down(state, context)
@@ -567,6 +605,7 @@ class EmbeddedPlanner:
             state.lines.append(f"put the {target} on the {_spoken(surface_name)}")
         state.held = None
         state.last = [target]
+        state.done[target] = ("on", surface_name)
         state.surface = surface_name
         state.position = approach
 
@@ -624,8 +663,15 @@ class EmbeddedPlanner:
 
     def _objects(self, phrase: str, state: _State, context: PlanningContext, bring: bool = False) -> list[str]:
         """The objects a phrase names: one, several listed, a count of a kind, or every one of a kind."""
-        words = _bare(phrase.strip())
-        if re.fullmatch(r"(?:it|that|this|that one|this one|the one you are holding|what you are holding)", words):
+        words = _bare(phrase.strip().strip(" ,"))
+        if HELD_PHRASE.match(words):
+            if state.held is None:
+                raise PlanRefused("I am not holding anything.")
+            return [state.held]
+        if state.pending and re.fullmatch(r"(?:them|those|these|both|all of them|em|it|that|everything)", words):
+            taken, state.pending = state.pending, []  # "grab every can and bin them"
+            return taken
+        if re.fullmatch(r"(?:it|that|this|that one|this one)", words):
             if not state.last:
                 raise PlanRefused("I don't know what 'it' is; name the object, for example 'the red cube'.")
             return state.last[-1:]
@@ -636,12 +682,11 @@ class EmbeddedPlanner:
         if state.mentioned and re.fullmatch(r"(?:one|some|one of those|one of them|something like that)", words):
             phrase = state.mentioned  # "bring one over": one of what the aside wanted
         wanted = read_wanted(phrase, _surface_words(context))
-        simple = len(wanted.items) == 1 and not (wanted.count or wanted.every or wanted.exclude or wanted.different)
-        if (
-            simple
-            and not self._categorical(wanted.items[0], context)
-            and _world_name_in(wanted.items[0], context) is None
-        ):
+        wanted.items = [part for item in wanted.items for part in _run_together(item, context)]
+        if not wanted.items:
+            raise PlanRefused(f"What should I take? I see the {_join(_seen_names(context)) or 'nothing yet'}.")
+        first = wanted.items[0].words
+        if wanted.simple and not self._categorical(first, context) and _world_name_in(first, context) is None:
             targets = [self._one_object(phrase, state, context)]
         else:
             targets = [t for item in wanted.items for t in self._choose(item, wanted, state, context)]
@@ -654,14 +699,14 @@ class EmbeddedPlanner:
         if state.last:
             return
         wanted = read_wanted(re.sub(r"^(?:i|we|someone|my \w+)\s+\w+\s+", "", aside), _surface_words(context))
-        for item in wanted.items:
-            for start in range(len(item.split())):  # the thing is named somewhere in the aside
-                words = " ".join(item.split()[start:])
+        for listed in wanted.items:
+            for start in range(len(listed.words.split())):  # the thing is named somewhere in the aside
+                words = " ".join(listed.words.split()[start:])
                 name = _world_name_in(words, context)
                 if name is not None:
                     seen = [o for o in context.belief.present() if _world_object(o, context) == name]
                     alike = [_name_of(o, context) for o in seen] or [name]
-                    state.last = alike if wanted.every or re.search(r"\b(?:both|all|every)\b", aside) else alike[:1]
+                    state.last = alike if listed.every or re.search(r"\b(?:both|all|every)\b", aside) else alike[:1]
                     return
         wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
         state.mentioned = wanting.group(0) if wanting else ""  # "my kid wants something sweet": "something sweet"
@@ -670,14 +715,15 @@ class EmbeddedPlanner:
         """Whether a phrase asks for things by what they are (categories, kinds) that this world's things have."""
         return bool(_candidates(item, context))
 
-    def _choose(self, item: str, wanted: Wanted, state: _State, context: PlanningContext) -> list[str]:
+    def _choose(self, listed: Item, wanted: Wanted, state: _State, context: PlanningContext) -> list[str]:
         """The things one listed item stands for: by name, or by what they are, seen ones first, nearest first."""
+        item = listed.words
         if item in ("it", "that", "this", "them", "those"):
             return self._objects(item, state, context)
         name = _world_name_in(item, context)
         kinds = [name] if name is not None else _candidates(item, context)
         if not kinds and not is_open(item):
-            if wanted.count or wanted.every:
+            if listed.count or listed.every:
                 raise PlanRefused(f"I don't see any {item}.")
             return [self._one_object(item, state, context)]
         if not kinds:
@@ -693,29 +739,29 @@ class EmbeddedPlanner:
         ]
         here = state.position
         seen.sort(key=lambda o: (o.held_by is None, float(np.hypot(*(o.position[:2] - here)))))
-        specific = wanted.every or wanted.count or wanted.source is not None  # which one matters: by its id
+        specific = listed.every or listed.count or wanted.source is not None  # which one matters: by its id
         pool = [_one_of(o, context) if specific else _name_of(o, context) for o in seen]
         of = {name: _world_object(o, context) for name, o in zip(pool, seen, strict=True)}
-        if not wanted.every:  # known to the world, not seen yet: find will look
+        if not listed.every and not (seen and (wanted.source or listed.definite)):  # not seen yet: find will look
             unseen = [k for k in kinds if k not in of.values()]
             pool += unseen
             of |= {k: k for k in unseen}
         fresh = [p for p in pool if p not in state.used]
         pool = fresh or pool
         what = item if name is None else name
-        if wanted.every:
+        if listed.every:
             if not pool:
                 raise PlanRefused(
                     f"I don't see any {item}{' on the ' + _spoken(wanted.source) if wanted.source else ''}."
                 )
             return pool
-        count = wanted.count or 1
-        if wanted.different or (count > 1 and name is None):
+        count = listed.count or 1
+        if listed.different or (count > 1 and name is None):
             distinct = {}
             for p in pool:
                 distinct.setdefault(of[p], p)
-            pool = list(distinct.values()) if wanted.different else pool
-        if count == 1 and wanted.definite and not is_open(item) and name is None:
+            pool = list(distinct.values()) if listed.different else pool
+        if count == 1 and listed.definite and not is_open(item) and name is None:
             options = list(dict.fromkeys(of[p] for p in pool))
             if len(options) > 1:  # "the caffeinated one" names one thing, and several fit: ask
                 raise Question(Choice(command="", phrase=item, options=options), _which(options))
@@ -867,7 +913,9 @@ def _is_bin_phrase(words: str, context: PlanningContext) -> bool:
 def _names_a_thing(words: str, context: PlanningContext) -> bool:
     """Whether words name something to bring: a thing by name, by what it is, or an open "something to eat"."""
     wanted = read_wanted(words, _surface_words(context))
-    return any(_world_name_in(i, context) or _candidates(i, context) or is_open(i) for i in wanted.items)
+    return any(
+        _world_name_in(i.words, context) or _candidates(i.words, context) or is_open(i.words) for i in wanted.items
+    )
 
 
 def _world_name_in(words: str, context: PlanningContext) -> str | None:
@@ -1084,6 +1132,18 @@ def _name_of(tracked: TrackedObject, context: PlanningContext) -> str:
         if (declared.kind, declared.colour) == (tracked.kind, tracked.colour)
     ]
     return named[0] if len(named) == 1 else tracked.id
+
+
+def _run_together(item: Item, context: PlanningContext) -> list[Item]:
+    """ "the coke the pepsi" (a comma dropped) as two items, when each part names a thing."""
+    parts = [p for p in re.split(r"\s+(?=the\s)", item.words) if p]
+    if len(parts) > 1 and all(_world_name_in(p, context) for p in parts):
+        return [Item(re.sub(r"^the\s+", "", p), definite=True) for p in parts]
+    return [item]
+
+
+def _seen_names(context: PlanningContext) -> list[str]:
+    return sorted({_name_of(o, context) for o in context.belief.present()})
 
 
 def _one_of(tracked: TrackedObject, context: PlanningContext) -> str:

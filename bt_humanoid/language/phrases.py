@@ -10,7 +10,7 @@ planner's business (``embedded.py``); this module only reads the words.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from bt_humanoid.language.lexicon import CATEGORY_WORDS, COUNT_WORDS, EVERY_WORDS, KIND_SYNONYMS
 
@@ -19,25 +19,39 @@ EXCLUSION = re.compile(
     r"\s*\b(?:but not|but|except for|except|other than|apart from|besides|excluding|instead of|rather than|"
     r"that is not|that are not|which is not|which are not|that does not have|that has no|not|without|with no|no)\b\s*"
 )
-LIST_BREAK = re.compile(r"\s*(?:,|\band also\b|\band\b|\bplus\b|\bas well as\b|\balong with\b|&)\s*")
+LIST_BREAK = re.compile(
+    r"\s*(?:,|\band also\b|\band then\b|\bthen\b|\bfollowed by\b|\band\b|\bplus\b|\bas well as\b|\balong with\b|&)\s*"
+)
 DIFFERENT = re.compile(r"\b(?:different|distinct|separate|various|assorted|other)\s+")
 SOURCE = re.compile(r"\s*\b(?:from|off of|off|on|at|in|sitting on|lying on|over on|over at|out of)\s+(?:the\s+)?")
 OPEN_WORDS = ("something", "anything", "one", "ones", "thing", "things", "stuff", "whatever")
 
 
 @dataclass
-class Wanted:
-    """An object phrase read: the things listed, how many, which not, from which surface."""
+class Item:
+    """One listed thing: its words (article and quantity gone) and how many of it."""
 
-    items: list[str]  # each listed thing's words, article gone ("apple", "bag of chips", "something fizzy")
-    count: int | None = None  # "three drinks": 3; None: one thing per item (or every, below)
+    words: str  # "apple", "bag of chips", "something fizzy"
+    count: int | None = None  # "three drinks": 3; None: one
     every: bool = False  # "all the cans", "every bottle", "everything on the table"
     different: bool = False  # "two different snacks": not two of one kind
+    definite: bool = False  # "the caffeinated one" names one thing; "a drink" lets the robot choose
+
+
+@dataclass
+class Wanted:
+    """An object phrase read: the things listed, which not, from which surface."""
+
+    items: list[Item]
     exclude: str = ""  # "anything but the apple": "apple"
     source: str | None = None  # the surface they come from ("the coke on the table")
-    definite: bool = False  # "the caffeinated one" names one thing; "a drink" lets the robot choose
     words: str = ""
-    categories: list[set[str]] = field(default_factory=list)  # per item, filled by the planner
+
+    @property
+    def simple(self) -> bool:
+        """One thing, named plainly: no count, no "every", no exclusion."""
+        item = self.items[0] if len(self.items) == 1 else None
+        return item is not None and not (item.count or item.every or item.different or self.exclude)
 
 
 def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
@@ -49,14 +63,23 @@ def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
     if excluded is not None:  # "anything but the apple", "a drink that is not fizzy", "not the apple"
         wanted.exclude = _bare(text[excluded.end() :])
         text = text[: excluded.start()].strip()
-    wanted.definite = bool(re.match(r"^(?:the|this|that|these|those|my|your)\b", text))
-    text, wanted.count, wanted.every = _quantity(text)
-    if DIFFERENT.search(text):
-        wanted.different = True
-        text = DIFFERENT.sub("", text)
-    items = [_bare(item) for item in LIST_BREAK.split(text) if _bare(item)]
-    wanted.items = items or (["anything"] if wanted.exclude or wanted.every else [])
+    for part in LIST_BREAK.split(text):
+        item = _item(part.strip())
+        if item is not None:
+            wanted.items.append(item)
+    if not wanted.items and wanted.exclude:
+        wanted.items = [Item("anything")]
     return wanted
+
+
+def _item(text: str) -> Item | None:
+    definite = bool(re.match(r"^(?:the|this|that|these|those|my|your)\b", text))
+    text, count, every = _quantity(text)
+    different = DIFFERENT.search(text) is not None
+    words = _bare(DIFFERENT.sub("", text))
+    if not words:
+        return Item("anything", count, every, different, definite) if every or count else None
+    return Item(words, count, every, different, definite)
 
 
 def _source(text: str, surfaces: dict[str, str]) -> tuple[str, str | None]:

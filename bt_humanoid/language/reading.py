@@ -28,13 +28,14 @@ from functools import lru_cache
 from lemminflect import getAllLemmas, getInflection
 from rapidfuzz import fuzz, process
 
-from bt_humanoid.language.lexicon import CATEGORY_WORDS, CONTRACTIONS, FILLERS, FRAMING, NEEDS, SLANG, WANTING
+from bt_humanoid.language.lexicon import CATEGORY_WORDS, CONTRACTIONS, FILLERS, FRAMING, NEEDS, SLANG, TYPOS, WANTING
 from bt_humanoid.language.vocabulary import split_clauses, starts_clause
 from bt_humanoid.language.words import normalise
 
+HOW_WOULD_YOU = re.compile(r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b", re.IGNORECASE)
 SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
 STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\d+[.)]?|[a-z][.)])\s+")
-MIN_TYPO_LENGTH = 4  # shorter words are too often other words ("ot", "teh" aside)
+MIN_TYPO_LENGTH = 3  # shorter words are too often other words
 TYPO_SCORE = 78.0  # rapidfuzz ratio (0-100) from which a word is taken for a known one
 STATEMENT = re.compile(  # a verb that tells ("the apples are soft"), not in a relative clause ("one that is …")
     r"(?<!that )(?<!which )(?<!who )\b(?:is|are|was|were|has|have|had|got|went|looks?|seems?|feels?)\b"
@@ -49,6 +50,8 @@ def read(text: str, known: frozenset[str]) -> list[str]:
     """The clauses of a request, each plain and corrected; ``known``: the words the robot knows (``known_words``)."""
     text = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode()  # jalapeño → jalapeno
     text = text.replace("’", "'").replace("->", " -> ").replace("→", " -> ")
+    text = HOW_WOULD_YOU.sub(" ", text)  # "how would you …" asks for the plan: the planner explains and does it
+    text = re.sub(r"\b(?:yourself|urself|itself)\b", " ", text, flags=re.IGNORECASE)
     clauses = []
     for sentence in SENTENCE_BREAK.split(" " + text.lower() + " "):
         sentence = STEP_NUMBER.sub("", sentence.strip())
@@ -70,7 +73,12 @@ def read(text: str, known: frozenset[str]) -> list[str]:
         clauses += [clause for piece in pieces for clause in split_clauses(piece)]
     clauses = [unframe(clause) for clause in clauses if unframe(clause)]
     asked = [c for c in clauses if c not in NEED_REQUESTS and not is_context(c)]
-    return [c for c in clauses if c not in NEED_REQUESTS or not asked]  # "i'm starving, bring me two snacks"
+    needs = [c for c in clauses if c in NEED_REQUESTS]
+    if not asked or not needs:
+        return clauses
+    # "i'm starving, bring me two snacks": the request says it; "i'm thirsty, bring me something": the need says what
+    wanted = NEED_REQUESTS[needs[0]]
+    return [re.sub(r"\b(?:something|anything)$", wanted, c) for c in clauses if c not in NEED_REQUESTS]
 
 
 def _joined(text: str, known: frozenset[str]) -> str:
@@ -88,6 +96,8 @@ def _joined(text: str, known: frozenset[str]) -> str:
 
 
 def _expand(word: str) -> str:
+    if word in TYPOS:
+        return TYPOS[word]
     if word in CONTRACTIONS:
         return CONTRACTIONS[word]
     if word in SLANG:
@@ -120,7 +130,7 @@ FILLER_AT_START = re.compile(
     r"^(?:" + "|".join(re.escape(f) for f in sorted(FILLERS, key=len, reverse=True)) + r")\b\s*"
 )
 WANT_AT_START = re.compile(r"^(?:" + "|".join(re.escape(w) for w in sorted(WANTING, key=len, reverse=True)) + r")\b\s*")
-NEED_REQUESTS = {f"bring me {wanted}" for wanted in NEEDS.values()}
+NEED_REQUESTS = {f"bring me {wanted}": wanted for wanted in NEEDS.values()}
 WOULD_BE = re.compile(
     r"^(?P<what>(?:some|a|an|something|anything)\b.*?)\s+(?:would|will|could)\s+(?:be|do|hit the spot)\b.*$"
 )

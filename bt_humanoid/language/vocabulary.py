@@ -103,7 +103,9 @@ INTENTS: dict[str, Intent] = {
         ("find", "say"),
     ),
     "take": Intent(
-        ("pick up", "grab", "take", "get", "lift", "collect"), ("pick", "grasp", "hold", "snag", "nab"), ("take",)
+        ("pick up", "grab", "take", "get", "lift", "collect"),
+        ("pick", "grasp", "hold", "snag", "nab", "hold on to", "hang on to", "keep hold of", "take hold of", "keep"),
+        ("take",),
     ),
     # "throw away the coke", "recycle the can", "compost the apple": into the bin that takes it
     "throw_away": Intent(
