@@ -781,6 +781,8 @@ class EmbeddedPlanner:
         if bare in context.world.surfaces or _place_name(bare, context) is not None:
             examples = ", the ".join(list(context.world.objects)[:3])
             raise PlanRefused(f"The {bare} is too big for me to carry; I can pick up things like the {examples}.")
+        if _unknown_thing(bare, context):  # "a banana" in a kitchen without one: not a look-alike
+            raise PlanRefused(_not_seen(bare, context))
         alike = _same_kind(bare, context)
         if len(alike) > 1:  # "the cube" with two cubes in the world, even if one has been seen so far
             raise Question(Choice(command="", phrase=phrase, options=alike), _which(alike))
@@ -993,6 +995,15 @@ def _excluded(words: str, context: PlanningContext) -> set[str]:
             continue
         out |= set(_candidates(part, context))
     return out
+
+
+def _unknown_thing(bare: str, context: PlanningContext) -> bool:
+    """A plain noun the world knows nothing by ("banana", "napkin"): no name, kind, category, colour or open word."""
+    words = _canonical(bare).split()
+    known = known_words(context) | set(KIND_WORDS) | {"something", "anything", "thing", "one", "stuff"}
+    if len(words) > 2 or any(w in known or w in COLOURS for w in words):
+        return False
+    return all("NOUN" in getAllLemmas(w) for w in words)
 
 
 def _same_kind(bare: str, context: PlanningContext) -> list[str]:

@@ -28,10 +28,24 @@ from functools import lru_cache
 from lemminflect import getAllLemmas, getInflection
 from rapidfuzz import fuzz, process
 
-from bt_humanoid.language.lexicon import CATEGORY_WORDS, CONTRACTIONS, FILLERS, FRAMING, NEEDS, SLANG, TYPOS, WANTING
+from bt_humanoid.language.lexicon import (
+    CATEGORY_WORDS,
+    CONTRACTIONS,
+    FILLERS,
+    FRAMING,
+    NEEDS,
+    SLANG,
+    TROUBLES,
+    TYPOS,
+    WANTING,
+)
 from bt_humanoid.language.vocabulary import split_clauses, starts_clause
 from bt_humanoid.language.words import normalise
 
+MID_FILLER = re.compile(  # words that say nothing wherever they stand
+    r"\b(?:when you get there|once you get there|once you are there|when you are there|while you are there|"
+    r"while you are at it|once there)\b"
+)
 HOW_WOULD_YOU = re.compile(r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b", re.IGNORECASE)
 SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
 STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\d+[.)]?|[a-z][.)])\s+")
@@ -61,6 +75,7 @@ def read(text: str, known: frozenset[str]) -> list[str]:
         words = [_expand(word) for word in plain.split()]
         plain = " ".join(w for w in words if w)
         plain = _joined(" ".join(correct(word, known) for word in plain.split()), known)
+        plain = MID_FILLER.sub(" ", plain).strip()
         pieces: list[str] = []
         for piece in re.split(r"\s*,\s*", plain):  # a comma ends a clause before a verb or an aside only
             piece = unframe(piece)
@@ -70,15 +85,50 @@ def read(text: str, known: frozenset[str]) -> list[str]:
                 pieces[-1] += " , " + piece
             else:
                 pieces.append(piece)
-        clauses += [clause for piece in pieces for clause in split_clauses(piece)]
+        clauses += [clause for piece in _in_order(pieces) for clause in split_clauses(piece)]
     clauses = [unframe(clause) for clause in clauses if unframe(clause)]
-    asked = [c for c in clauses if c not in NEED_REQUESTS and not is_context(c)]
+    clauses = _in_order(clauses)
+    if clauses and all(is_context(c) for c in clauses):  # "my desk is sticky, help": the trouble says what
+        trouble = next((TROUBLES[w] for c in clauses for w in c.split() if w in TROUBLES), None)
+        if trouble is not None:
+            clauses.append(f"bring me {trouble}")
     needs = [c for c in clauses if c in NEED_REQUESTS]
+    clauses = [c for i, c in enumerate(clauses) if c not in NEED_REQUESTS or c not in clauses[:i]]  # said twice
+    asked = [c for c in clauses if c not in NEED_REQUESTS and not is_context(c)]
     if not asked or not needs:
         return clauses
     # "i'm starving, bring me two snacks": the request says it; "i'm thirsty, bring me something": the need says what
     wanted = NEED_REQUESTS[needs[0]]
     return [re.sub(r"\b(?:something|anything)$", wanted, c) for c in clauses if c not in NEED_REQUESTS]
+
+
+def _in_order(clauses: list[str]) -> list[str]:
+    """Clauses in the order to do them: "before you come back, grab the red bull" → grab, then come back;
+    "once you've picked up the apple, put it …" → pick up, then put; "if you see a coke, …" names the coke."""
+    out: list[str] = []
+    later: list[str] = []
+    for clause in clauses:
+        before = re.match(r"^before (?:you|i)\s+(?P<rest>.+)$", clause)
+        if before is not None:
+            later.append(_base_form(before["rest"]))
+            continue
+        once = re.match(r"^(?:once|after|when|as soon as) you(?: have| are)?\s+(?P<rest>.+)$", clause)
+        if once is not None:
+            clause = _base_form(once["rest"])
+        seen = re.match(r"^if you (?:see|find|spot|can find) (?P<thing>.+)$", clause)
+        if seen is not None:
+            clause = f"with {seen['thing']}"
+        out.append(clause)
+        out += later
+        later = []
+    return out + later
+
+
+def _base_form(clause: str) -> str:
+    """ "picked up the apple" → "pick up the apple"."""
+    first, _, rest = clause.partition(" ")
+    lemma = getAllLemmas(first).get("VERB", (first,))[0]
+    return f"{lemma} {rest}".strip()
 
 
 def _joined(text: str, known: frozenset[str]) -> str:
@@ -100,6 +150,9 @@ def _expand(word: str) -> str:
         return TYPOS[word]
     if word in CONTRACTIONS:
         return CONTRACTIONS[word]
+    for ending, full in (("'d", " would"), ("'ll", " will"), ("'re", " are"), ("'ve", " have")):
+        if word.endswith(ending) and len(word) > len(ending) + 1:  # "it'd", "we'll", "they're"
+            return word[: -len(ending)] + full
     if word in SLANG:
         return SLANG[word]
     if word.endswith("'s") and len(word) > 3:

@@ -53,7 +53,7 @@ INTENTS: dict[str, Intent] = {
     "stop": Intent(("stop", "halt", "freeze"), ("stand still", "abort", "cancel")),
     "say": Intent(("say",), ("tell me", "tell us", "tell them", "tell everyone", "announce"), ("say",)),
     "wave": Intent(("wave",), (), ("wave",)),
-    "step": Intent(("walk", "go", "move", "drive"), ("step", "roll", "come", "back up", "head"), ("move_base",)),
+    "step": Intent(("walk", "go", "move", "drive"), ("step", "roll", "back up", "head"), ("move_base",)),
     "back_up": Intent((), ("back up",), ("move_base",)),
     "turn": Intent(("turn", "rotate"), ("spin",), ("move_base",)),
     "face": Intent(
@@ -99,7 +99,8 @@ INTENTS: dict[str, Intent] = {
     ),
     "find": Intent(
         ("find", "where is", "look for"),
-        ("search for", "locate", "where's", "where are", "look at", "show me", "can you see", "do you see"),
+        ("search for", "locate", "where's", "where are", "look at", "show me", "can you see", "do you see")
+        + ("have you seen", "i am looking for", "where did i leave", "where did i put", "do you know where"),
         ("find", "say"),
     ),
     "take": Intent(
