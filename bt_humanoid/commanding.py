@@ -72,7 +72,29 @@ def plan_from_here(
     first = EmbeddedPlanner().plan(text, stack.planning_context())  # offline and quick, whatever plans after
     if first.involves_things():
         look_around(stack)
+    if first.survey or EmbeddedPlanner().plan(text, stack.planning_context()).survey:
+        survey(stack)  # "recycle all the cans": look at every surface before counting
     return plan_command(text, stack.planning_context(), answers, planner)
+
+
+def survey(stack: RobotStack) -> None:
+    """Go to each surface's place, nearest first, and look left, ahead and right there: for a request that
+    counts things or takes every one of a kind, what the robot saw from afar is not enough."""
+    pan = stack.robot_config.head_pan
+    if pan is None or stack.perceiver is None or stack.navigator is None:
+        return
+    here = np.asarray(stack.robot.base.pose()[:2])
+    places = sorted(
+        {surface.place for surface in stack.world.surfaces.values()},
+        key=lambda p: float(np.hypot(*(np.asarray(stack.world.places[p].pose[:2]) - here))),
+    )
+    steps: list[dict[str, Any]] = []
+    for place in places:
+        steps.append({"navigate": {"place": place}})
+        steps += [{"move_joints": {"joints": {pan: angle}}} for angle in (*LOOK_AROUND[1:], 0.0)]
+    header = {"mission": "look at every surface", "world": stack.world.name, "robot": stack.robot_config.name}
+    spec = MissionLoader.for_plans().load_data({**header, "tree": {"sequence": steps}}, name="<survey>")
+    MissionRun(stack, spec).execute()
 
 
 def make_planner(settings: LlmSettings | None) -> EmbeddedPlanner | LlmPlanner:

@@ -336,3 +336,10 @@ def test_bt_plan_uses_the_endpoint_given_on_the_command_line(model, capsys):
     code = plan_main(["bring the mug", "--llm-url", model.url, "--llm-model", "scripted"])
     assert code == EXIT_OK
     assert "robot: I will fetch the mug." in capsys.readouterr().out
+
+
+def test_the_hand_check_reads_plans_with_the_mission_language_s_node_extras():
+    from bt_humanoid.language import llm
+    from bt_humanoid.mission.schema import NODE_EXTRAS
+
+    assert tuple(llm.NODE_EXTRAS) == tuple(NODE_EXTRAS)

@@ -141,6 +141,7 @@ class _State:
     mentioned: str = ""  # an aside that says what is wanted ("my kid wants something sweet"): for "one"
     pending: list[str] = field(default_factory=list)  # "grab every can (and bin them)": taken by the next clause
     done: dict[str, tuple[str, str]] = field(default_factory=dict)  # where this plan has already put things
+    counted: bool = False  # a count or "every": the answer depends on everything there is
 
     @classmethod
     def at_start(cls, context: PlanningContext) -> _State:
@@ -187,7 +188,8 @@ class EmbeddedPlanner:
             return Plan("question", str(question), choice=question.choice, planning_time=time.perf_counter() - started)
         except PlanRefused as refusal:
             understood = not isinstance(refusal, NotUnderstood)
-            return Plan("refusal", str(refusal), planning_time=time.perf_counter() - started, understood=understood)
+            seconds = time.perf_counter() - started
+            return Plan("refusal", str(refusal), planning_time=seconds, understood=understood, survey=state.counted)
         if not state.steps:  # asked for what is already so: say so, do nothing
             state.steps.append({"say": {"text": _sentence(_join(state.lines)) if state.lines else "Done."}})
         tree = state.steps[0] if len(state.steps) == 1 else {"sequence": state.steps}
@@ -199,7 +201,8 @@ class EmbeddedPlanner:
         }
         would = re.search(r"\bhow (?:would|do|could|can|will|should) (?:you|i)\b", text.lower())
         summary = ("I would " if would else "I will ") + _join(state.lines) + "."
-        return Plan("mission", summary, mission=mission, planning_time=time.perf_counter() - started)
+        seconds = time.perf_counter() - started
+        return Plan("mission", summary, mission=mission, planning_time=seconds, survey=state.counted)
 
     def answer(self, choice: Choice, reply: str, context: PlanningContext) -> Plan:
         """Continue a command after a question: the reply picks one of the choice's options."""
@@ -305,7 +308,7 @@ class EmbeddedPlanner:
             return "clear"
         if "clear" in kinds:  # "tidy the chips away (onto the counter)": put it away, or back where it belongs
             rest = re.sub(r"\s+(?:away|up)\b", "", rest)
-            what, where = _split_destination(rest, context, moving=True)
+            _what, where = _split_destination(rest, context, moving=True)
             self._transfer("put", rest if where else f"{rest} back", state, context)
             return "transfer"
         somewhere = not rest or re.match(
@@ -705,8 +708,10 @@ class EmbeddedPlanner:
                 name = _world_name_in(words, context)
                 if name is not None:
                     seen = [o for o in context.belief.present() if _world_object(o, context) == name]
-                    alike = [_name_of(o, context) for o in seen] or [name]
-                    state.last = alike if listed.every or re.search(r"\b(?:both|all|every)\b", aside) else alike[:1]
+                    alike = [_one_of(o, context) for o in seen] or [name]
+                    several = bool(listed.every or re.search(r"\b(?:both|all|every)\b", aside))
+                    state.counted |= several
+                    state.last = alike if several else alike[:1]
                     return
         wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
         state.mentioned = wanting.group(0) if wanting else ""  # "my kid wants something sweet": "something sweet"
@@ -740,6 +745,7 @@ class EmbeddedPlanner:
         here = state.position
         seen.sort(key=lambda o: (o.held_by is None, float(np.hypot(*(o.position[:2] - here)))))
         specific = listed.every or listed.count or wanted.source is not None  # which one matters: by its id
+        state.counted |= bool(listed.every or (listed.count or 1) > 1 or wanted.source)
         pool = [_one_of(o, context) if specific else _name_of(o, context) for o in seen]
         of = {name: _world_object(o, context) for name, o in zip(pool, seen, strict=True)}
         if not listed.every and not (seen and (wanted.source or listed.definite)):  # not seen yet: find will look

@@ -32,7 +32,6 @@ from typing import Any
 import numpy as np
 
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
-from bt_humanoid.mission.schema import COMPOSITES, NODE_EXTRAS
 from bt_humanoid.perception.world_model import TrackedObject
 from bt_humanoid.sim.world_config import WorldObject
 
@@ -349,6 +348,8 @@ CARRIES_OFF = {"fetch", "throw_away"}  # steps that pick up and let go again
 GIVES_AWAY = {"give", "drop", "throw_away"}  # after these the thing is with a person or in a bin
 ONE_AT_A_TIME = {"sequence", "reactive_sequence"}  # composites whose children run one after another
 UNKNOWN = "?"  # what the hand holds when branches of a plan disagree: not checked further
+NODE_EXTRAS = ("name", "recovery")  # keys beside a node's kind (mission/schema.py's; a test keeps them equal:
+# the language layer sits below the mission language and reads plans as plain data)
 
 
 @dataclass
@@ -378,8 +379,8 @@ def _follow(node: dict[str, Any], path: str, hand: _Hand, context: PlanningConte
     if kind in ONE_AT_A_TIME:
         for i, child in enumerate(body):
             _follow(child, f"{where}[{i}]", hand, context, problems)
-    elif kind in COMPOSITES or kind == "parallel":  # alternatives, or at once: each from the same hand
-        children = body["children"] if kind == "parallel" else body
+    elif isinstance(body, list) or (isinstance(body, dict) and "children" in body):  # alternatives, or at once
+        children = body["children"] if isinstance(body, dict) else body
         _branches(children, where, hand, context, problems)
     elif isinstance(body, dict) and isinstance(body.get("child"), dict):  # a decorator: its child, once
         _follow(body["child"], where, hand, context, problems)

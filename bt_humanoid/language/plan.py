@@ -37,6 +37,7 @@ class Plan:
     choice: Choice | None = None  # for a question
     planning_time: float = 0.0  # s of wall time from text to this plan
     understood: bool = True  # False for a refusal of words the planner could not read as any request
+    survey: bool = False  # it counts things or takes every one of a kind: worth a look at every surface first
 
     def involves_things(self) -> bool:
         """Whether the answer depends on what the robot sees: a mission that handles objects, a question, or a

@@ -99,8 +99,21 @@ INTENTS: dict[str, Intent] = {
     ),
     "find": Intent(
         ("find", "where is", "look for"),
-        ("search for", "locate", "where's", "where are", "look at", "show me", "can you see", "do you see")
-        + ("have you seen", "i am looking for", "where did i leave", "where did i put", "do you know where"),
+        (
+            "search for",
+            "locate",
+            "where's",
+            "where are",
+            "look at",
+            "show me",
+            "can you see",
+            "do you see",
+            "have you seen",
+            "i am looking for",
+            "where did i leave",
+            "where did i put",
+            "do you know where",
+        ),
         ("find", "say"),
     ),
     "take": Intent(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from typing import Any
 
@@ -42,11 +43,16 @@ def check_name(value: str | None, valid: Iterable[str], parameter: str, what: st
     return [(parameter, f"unknown {what} '{value}' ({did_you_mean(value, valid)})")]
 
 
+TRACKED_ID = re.compile(r"[a-z]+-\d+")  # perception's ids: "can-3", "fruit-2" (perception/world_model.py)
+
+
 def check_object(value: str | None, world: WorldConfig, parameter: str = OBJECT_PARAMETER) -> list[tuple[str, str]]:
     """Compile-time check of an object parameter: a name the world gives (or one of a scene's: "coke 2" is a
     second coke), or a phrase to ground when it runs."""
     names = list(world.objects)
     if value is None or world.object_of(value) is not None or describes_an_object(value, [*names, *world.surfaces]):
+        return []
+    if TRACKED_ID.fullmatch(value):  # the robot's own id for a thing it saw: a plan names one of two alike by it
         return []
     example = 'or a description such as "the red cube" or "the cup on the counter"'
     return [(parameter, f"unknown object '{value}' ({did_you_mean(value, names)}), {example}")]
