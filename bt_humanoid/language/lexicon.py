@@ -152,6 +152,7 @@ FRAMING = (
     "do you think you could",
     "do you mind",
     "would you mind",
+    "mind",  # what is left of "would you mind …" once the plain text drops "would you"
     "could you please",
     "can you please",
     "would you please",

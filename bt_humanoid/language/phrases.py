@@ -67,6 +67,8 @@ def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
         item = _item(part.strip())
         if item is not None:
             wanted.items.append(item)
+    if len(wanted.items) > 1:  # "a snack, anything but the apple": the bare "anything" restates the snack
+        wanted.items = [item for item in wanted.items if item.words not in OPEN_WORDS] or wanted.items[:1]
     if not wanted.items and wanted.exclude:
         wanted.items = [Item("anything")]
     return wanted

@@ -57,14 +57,20 @@ def tell_object_poses(belief: WorldModel, sim: Simulation) -> None:
         belief.update(tracked)
 
 
-def told_planning_context(world: str = "apartment") -> PlanningContext:
-    """A planner's view of ``world`` with every declared object told, from its start pose: language, not sight."""
+def told_planning_context(world: str = "apartment", scene: SceneConfig | None = None) -> PlanningContext:
+    """A planner's view of ``world`` (and ``scene``: its objects, start and what is in hand) with every object
+    told, from where the robot starts: language, not sight. What the robot holds it knows as it would."""
     from bt_humanoid.engine.stack import RobotStack
 
-    stack = RobotStack.load(world, "wheeled_humanoid")
+    stack = RobotStack.load(world, "wheeled_humanoid", scene=scene)
     stack.close()  # no looking: told, not seen
-    tell_object_poses(stack.context.world_model, stack.sim)
-    return PlanningContext(stack.world, stack.context.world_model, np.zeros(3))
+    held = stack.sim.held
+    belief = stack.context.world_model
+    for tracked in told_objects(stack.sim):
+        in_hand = held is not None and tracked.name == held.name
+        if not in_hand:  # the one in hand the robot already believes, where its hand holds it
+            belief.update(tracked)
+    return PlanningContext(stack.world, belief, np.asarray(stack.robot.base.pose(), dtype=float))
 
 
 def told_stack(world: WorldConfig, robot: RobotConfig, seed: int = 0, scene: SceneConfig | None = None) -> RobotStack:

@@ -1,0 +1,57 @@
+"""Reading requests as people write them (language/reading.py, phrases.py): what the planner is handed."""
+
+import pytest
+
+from bt_humanoid.language.embedded import known_words
+from bt_humanoid.language.phrases import read_wanted
+from bt_humanoid.language.reading import correct, read
+from bt_humanoid.testing.told import told_planning_context
+
+
+@pytest.fixture(scope="module")
+def known() -> frozenset[str]:
+    return known_words(told_planning_context("kitchen"))
+
+
+@pytest.mark.parametrize(
+    ("text", "clauses"),
+    [
+        ("Could you bring me the wter botle?", ["bring me the water bottle"]),
+        ("put the aple on the tabel", ["put the apple on the table"]),
+        ("Would you mind grabbing the pepsi for me?", ["grab the pepsi"]),
+        ("I'm parched", ["bring me something to drink"]),
+        ("I'd like the apple", ["bring me the apple"]),
+        (
+            "I knocked my drink over. Could you get me something to mop it up?",
+            [
+                "i knocked my drink over",
+                "bring me something to mop it up",
+            ],
+        ),
+        ("I'm thirsty, bring me something", ["bring me something to drink"]),
+        ("I'm starving, bring me two snacks", ["bring me two snacks"]),
+        ("before you come back, grab the red bull", ["grab the red bull", "come back"]),
+        ("1. go to the table 2. pick up the coke", ["go to the table", "pick up the coke"]),
+        ("how would you recycle the 7 up can?", ["recycle the 7up can"]),
+        ("my desk is sticky, help", ["my desk is sticky", "bring me something to clean with"]),
+    ],
+)
+def test_requests_are_read_into_plain_clauses(known, text, clauses):
+    assert read(text, known) == clauses
+
+
+def test_english_words_are_not_corrected_into_names(known):
+    assert correct("knocked", known) == "knocked"  # a word of English, not a misspelt "kettle"
+    assert correct("botle", known) == "bottle"
+
+
+def test_object_phrases_say_how_many_which_not_and_from_where():
+    surfaces = {"table": "table", "far counter": "far_counter"}
+    wanted = read_wanted("two different snacks and a drink", surfaces)
+    assert [(i.words, i.count, i.different) for i in wanted.items] == [("snacks", 2, True), ("drink", None, False)]
+    every = read_wanted("all the cans on the far counter", surfaces)
+    assert every.items[0].every and every.items[0].words == "cans" and every.source == "far_counter"
+    but = read_wanted("a drink that is not fizzy", surfaces)
+    assert but.items[0].words == "drink" and but.exclude == "fizzy"
+    both = read_wanted("both chip bags", surfaces)
+    assert both.items[0].count == 2
