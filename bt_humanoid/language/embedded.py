@@ -292,6 +292,15 @@ class EmbeddedPlanner:
         if verb is None:
             return self._verbless(clause, state, context)
         kinds = [kind for kind in VERB_CLASSES if verb in INTENTS[kind].verbs]
+        if "go" in kinds or "come" in kinds:
+            errand = re.sub(r"^(?:and|to)\s+", "", rest)
+            second, _ = _verb_of(errand)
+            errands = TAKE_ONLY | BRING_ONLY | set(INTENTS["put"].verbs) | set(INTENTS["throw_away"].verbs)
+            if second is not None and second in errands:
+                return self._clause(errand, state, context)  # "go get the sponge": the errand is the request
+            if re.search(r"\s+with (?:it|them|that)$", rest) and state.held is not None:  # "come back with it"
+                self._bring(state.held, state, context)
+                return "transfer"
         if verb == "drop" and re.match(r"^(?:it|them|that|those)?\s*(?:in|into|inside)\b", rest):
             kinds.insert(0, "throw_away")  # "drop it in (the bin)"
         tossed_to_me = verb == "toss" and re.match(r"^(?:me|us)\b", rest)
@@ -365,6 +374,11 @@ class EmbeddedPlanner:
 
     def _transfer(self, verb: str, rest: str, state: _State, context: PlanningContext, release: bool = False) -> None:
         """Take things, and bring them to the person, put them on a surface or drop them in a bin."""
+        pairs = [p for p in re.split(r"\s*(?:,\s*)?\band\s+|\s*,\s*", rest) if p]
+        if len(pairs) > 1 and all(_split_destination(p, context, moving=True)[1] for p in pairs):
+            for pair in pairs:  # "put the coke on the table and the pepsi on the far counter"
+                self._transfer(verb, pair, state, context, release)
+            return
         to_person = bool(re.match(r"^(?:me|us)\b", rest)) and verb not in ("put", "set", "place", "leave")
         rest = re.sub(r"^(?:me|us)\s+", "", rest) if to_person else rest
         restock = re.match(r"^(?P<where>.+?)\s+with\s+(?P<what>.+)$", rest)
@@ -470,7 +484,7 @@ class EmbeddedPlanner:
         rest = re.sub(
             r"^(?:back\s+)?(?:over\s+)?(?:round|around|to|into|towards?|by|next to|up to|at|in)?\s*", "", rest
         )
-        if not rest and verb in ("do a lap", "visit", "park", "stop by", "swing by"):
+        if not rest and verb in ("do a lap", "visit", "park", "stop by", "swing by", "go", "head", "walk", "drive"):
             raise NotUnderstood(f"Where should I {verb}? I know the {_surfaces(context)}.")
         if not rest or rest in ("back", "here", "home"):
             if verb == "come" or rest in ("back", "here"):
@@ -636,10 +650,13 @@ class EmbeddedPlanner:
         """The surface a thing stands on, or was just put on by this plan ("next to it")."""
         if _bare(words) in ("it", "that", "them", "this"):
             return state.surface
+        last, used = list(state.last), set(state.used)
         try:
             names = self._objects(words, state, context)
         except (PlanRefused, Question):
             return None
+        finally:  # naming the neighbour does not make it "it"
+            state.last, state.used = last, used
         tracked = _tracked(names[0], context) if names else None
         under = context.belief.surface_under(tracked.position) if tracked is not None else None
         return under.name if under is not None else None
