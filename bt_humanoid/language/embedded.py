@@ -386,8 +386,8 @@ class EmbeddedPlanner:
             rest = f"{restock['what']} on {restock['where']}"  # "restock the table with a water bottle"
         if HERE.search(rest) and not (rest.endswith(" back") and verb not in BRING_ONLY):  # "put it back": not me
             to_person, rest = True, HERE.sub("", rest)
-        away = re.search(r"\s+away$", rest) is not None and verb not in INTENTS["throw_away"].verbs  # "put it away"
-        rest = re.sub(r"\s+away$", "", rest) if away else rest
+        away = re.search(r"(?:^|\s+)away(?:\s+|$)", rest) is not None and verb not in INTENTS["throw_away"].verbs
+        rest = re.sub(r"(?:^|\s+)away(?=\s+|$)", "", rest).strip() if away else rest  # "put (it) away"
         back = bool(_back(rest, context)) or verb in ("return", "restock") or away
         down = bool(DOWN.search(rest)) or release
         rest = DOWN.sub(" ", _back(rest, context) or rest).strip()
@@ -481,6 +481,9 @@ class EmbeddedPlanner:
         second, after = _verb_of(rest)
         if second is not None and second in INTENTS["go"].verbs:  # "go park by the counter"
             rest = after
+        rest = re.sub(
+            r"^(?:and\s+)?(?:check(?: on)?|look at|have a look at|see|check out)\s+", "", rest
+        )  # "go check …"
         rest = re.sub(
             r"^(?:back\s+)?(?:over\s+)?(?:round|around|to|into|towards?|by|next to|up to|at|in)?\s*", "", rest
         )
@@ -688,7 +691,8 @@ class EmbeddedPlanner:
             if state.held is None:
                 raise PlanRefused("I am not holding anything.")
             return [state.held]
-        if state.pending and re.fullmatch(r"(?:them|those|these|both|all of them|em|it|that|everything)", words):
+        pending_words = r"(?:them|those|these|both|all of them|em|it|that|everything|them both|both of them|the two)"
+        if state.pending and re.fullmatch(pending_words, words):
             taken, state.pending = state.pending, []  # "grab every can and bin them"
             return taken
         if re.fullmatch(r"(?:it|that|this|that one|this one)", words):
@@ -778,6 +782,8 @@ class EmbeddedPlanner:
                     f"I don't see any {item}{' on the ' + _spoken(wanted.source) if wanted.source else ''}."
                 )
             return pool
+        if listed.definite and not listed.count and name is None and _plural_of_a_kind(item, context):
+            return pool if pool else self._choose(Item(item, every=True), wanted, state, context)  # "the bottles"
         count = listed.count or 1
         if listed.different or (count > 1 and name is None):
             distinct = {}
@@ -1174,6 +1180,15 @@ def _run_together(item: Item, context: PlanningContext) -> list[Item]:
     if len(parts) > 1 and all(_world_name_in(p, context) for p in parts):
         return [Item(re.sub(r"^the\s+", "", p), definite=True) for p in parts]
     return [item]
+
+
+def _plural_of_a_kind(item: str, context: PlanningContext) -> bool:
+    """ "the bottles", "the drinks": a plural of a kind or category (every one of them), not a name's "chips"."""
+    last = item.split()[-1]
+    singular = _singular(last)
+    kinds = {o.kind for o in context.world.objects.values()}
+    categories = {c for o in context.world.objects.values() for c in o.categories}
+    return last.endswith("s") and singular != last and singular in kinds | categories and singular != "chip"
 
 
 def _seen_names(context: PlanningContext) -> list[str]:

@@ -44,7 +44,7 @@ from bt_humanoid.language.words import normalise
 
 MID_FILLER = re.compile(  # words that say nothing wherever they stand
     r"\b(?:when you get there|once you get there|once you are there|when you are there|while you are there|"
-    r"while you are at it|once there)\b"
+    r"while you are at it|once there|one by one|one at a time|in turn)\b"
 )
 HOW_WOULD_YOU = re.compile(r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b", re.IGNORECASE)
 SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
