@@ -54,9 +54,7 @@ def look_around(stack: RobotStack) -> None:
         return
     turns = [{"move_joints": {"joints": {pan: angle}}} for angle in (*LOOK_AROUND[1:], 0.0)]
     turns.append({"rotate_in_place": {"angle": 360.0}})
-    glance = {"mission": "look around", "world": stack.world.name, "robot": stack.robot_config.name}
-    spec = MissionLoader.for_plans().load_data({**glance, "tree": {"sequence": turns}}, name="<look around>")
-    MissionRun(stack, spec).execute()
+    _run_steps(stack, "look around", turns)
     stack.look()
 
 
@@ -92,8 +90,13 @@ def survey(stack: RobotStack) -> None:
     for place in places:
         steps.append({"navigate": {"place": place}})
         steps += [{"move_joints": {"joints": {pan: angle}}} for angle in (*LOOK_AROUND[1:], 0.0)]
-    header = {"mission": "look at every surface", "world": stack.world.name, "robot": stack.robot_config.name}
-    spec = MissionLoader.for_plans().load_data({**header, "tree": {"sequence": steps}}, name="<survey>")
+    _run_steps(stack, "look at every surface", steps)
+
+
+def _run_steps(stack: RobotStack, name: str, steps: list[dict[str, Any]]) -> None:
+    """Run a few steps on ``stack`` as a mission of their own (checked, with safety), before planning."""
+    header = {"mission": name, "world": stack.world.name, "robot": stack.robot_config.name}
+    spec = MissionLoader.for_plans().load_data({**header, "tree": {"sequence": steps}}, name=f"<{name}>")
     MissionRun(stack, spec).execute()
 
 
