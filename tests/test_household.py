@@ -139,6 +139,7 @@ def _planned_right(scene: str, say: str, expect: list[dict]) -> str | None:
         ("default", "take the sponge and move it to the table", [{"on": ["sponge", "table"]}]),
         ("default", "go round every counter and come back", [{"visited": ["close_counter", "far_counter"]}]),
         ("default", "how would you put the tea on the table?", [{"on": ["tea", "table"]}]),
+        ("default", "please recycle the bottles", [{"inside": ["bottle", "recycling_bin"], "count": "all"}]),
         ("holding_coke", "bring me a coke", [{"delivered": "coke"}]),
         ("holding_coke", "bring me the pepsi", [{"delivered": "pepsi"}]),
         ("holding_coke", "put it down", [{"on": ["coke", "any"]}]),

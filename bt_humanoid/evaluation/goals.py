@@ -296,7 +296,7 @@ def truth_situation(truth: GroundTruth, visited: set[str]) -> Situation:
     for name, obj in truth.sim.object_kinds.items():
         things[name] = _where(truth, name, world.objects[obj].upright)
     x, y, _ = truth.robot_pose()
-    at = next((p for p, place in world.places.items() if math.dist((x, y), place.pose[:2]) <= PLACE_REACHED), None)
+    at = next(iter(places_reached(truth)), None)
     if at is None and any(math.dist((x, y), truth.person_position(p)[:2]) <= PERSON_REACHED for p in world.people):
         at = PERSON
     return Situation(things, robot_at=at, visited=set(visited))

@@ -21,7 +21,9 @@ from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.evaluation.goals import (
     Catalogue,
+    Goal,
     PlanInvalid,
+    Situation,
     overreach,
     places_reached,
     plan_situation,
@@ -30,8 +32,9 @@ from bt_humanoid.evaluation.goals import (
     unmet,
 )
 from bt_humanoid.evaluation.suite import Suite, instruction_scene
+from bt_humanoid.language.plan import Plan
 from bt_humanoid.mission.loader import MissionLoader
-from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 
 VISIT_EVERY = 25  # control steps between looks at which place the robot stands at (visited: goals)
 
@@ -104,7 +107,9 @@ def _instances(stack: RobotStack) -> dict[str, str]:
     return found
 
 
-def _judge_plan(plan, start, catalogue: Catalogue, world, goals, instances: dict[str, str]) -> str | None:
+def _judge_plan(
+    plan: Plan, start: Situation, catalogue: Catalogue, world: WorldConfig, goals: list[Goal], instances: dict[str, str]
+) -> str | None:
     """Why a plan does not do what the instruction asks (None: it does)."""
     if plan.kind != "mission" or plan.mission is None:
         return f"{plan.kind}: {plan.say}"

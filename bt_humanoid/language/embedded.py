@@ -406,7 +406,7 @@ class EmbeddedPlanner:
         if where is not None and where[0] == "person":
             to_person = True
         if to_person:
-            targets = self._objects(what, state, context, bring=True)
+            targets = self._objects(what, state, context)
             targets.sort(key=lambda t: t != state.held)  # what is in hand first: it is on its way already
             for target in targets:
                 self._bring(target, state, context)
@@ -421,7 +421,7 @@ class EmbeddedPlanner:
             return
         if where is None:
             if verb in BRING_ONLY:
-                for target in self._objects(what, state, context, bring=True):
+                for target in self._objects(what, state, context):
                     self._bring(target, state, context)
                 return
             if verb not in TAKE_ONLY and verb not in INTENTS["take"].verbs:
@@ -684,7 +684,7 @@ class EmbeddedPlanner:
 
     # --- objects ------------------------------------------------------------------
 
-    def _objects(self, phrase: str, state: _State, context: PlanningContext, bring: bool = False) -> list[str]:
+    def _objects(self, phrase: str, state: _State, context: PlanningContext) -> list[str]:
         """The objects a phrase names: one, several listed, a count of a kind, or every one of a kind."""
         words = _bare(phrase.strip().strip(" ,"))
         if HELD_PHRASE.match(words):
@@ -710,7 +710,7 @@ class EmbeddedPlanner:
         if not wanted.items:
             raise PlanRefused(f"What should I take? I see the {_join(_seen_names(context)) or 'nothing yet'}.")
         first = wanted.items[0].words
-        if wanted.simple and not self._categorical(first, context) and _world_name_in(first, context) is None:
+        if wanted.simple and not _candidates(first, context) and _world_name_in(first, context) is None:
             targets = [self._one_object(phrase, state, context)]
         else:
             targets = [t for item in wanted.items for t in self._choose(item, wanted, state, context)]
@@ -736,10 +736,6 @@ class EmbeddedPlanner:
                     return
         wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
         state.mentioned = wanting.group(0) if wanting else ""  # "my kid wants something sweet": "something sweet"
-
-    def _categorical(self, item: str, context: PlanningContext) -> bool:
-        """Whether a phrase asks for things by what they are (categories, kinds) that this world's things have."""
-        return bool(_candidates(item, context))
 
     def _choose(self, listed: Item, wanted: Wanted, state: _State, context: PlanningContext) -> list[str]:
         """The things one listed item stands for: by name, or by what they are, seen ones first, nearest first."""
@@ -931,9 +927,11 @@ def _unknown_verb(clause: str, context: PlanningContext) -> bool:
     if first in known_words(context) or first in ("a", "an", "the", "some", "any", "one", "to", "with", "back"):
         return False
     lemmas = getAllLemmas(first)
-    return ("VERB" in lemmas and "NOUN" not in lemmas) or (
-        "VERB" in lemmas and len(clause.split()) > 2 and clause.split()[1] in ("the", "a", "an", "my", "it", "them")
-    )
+    if "VERB" not in lemmas:
+        return False
+    words = clause.split()
+    followed_by_a_thing = len(words) > 2 and words[1] in ("the", "a", "an", "my", "it", "them")  # "swap the …"
+    return "NOUN" not in lemmas or followed_by_a_thing
 
 
 def _is_bin_phrase(words: str, context: PlanningContext) -> bool:
@@ -1183,12 +1181,15 @@ def _run_together(item: Item, context: PlanningContext) -> list[Item]:
 
 
 def _plural_of_a_kind(item: str, context: PlanningContext) -> bool:
-    """ "the bottles", "the drinks": a plural of a kind or category (every one of them), not a name's "chips"."""
+    """ "the bottles", "the drinks": a plural of a kind or category (every one of them), unless names end in
+    that very plural ("the chips" may mean the kettle chips: one bag)."""
     last = item.split()[-1]
     singular = _singular(last)
-    kinds = {o.kind for o in context.world.objects.values()}
-    categories = {c for o in context.world.objects.values() for c in o.categories}
-    return last.endswith("s") and singular != last and singular in kinds | categories and singular != "chip"
+    objects = context.world.objects
+    kinds = {o.kind for o in objects.values()}
+    categories = {c for o in objects.values() for c in o.categories}
+    name_ends = {n.split()[-1] for name, o in objects.items() for n in (name, *o.aliases)}  # "chips", not "can"
+    return last.endswith("s") and singular != last and singular in kinds | categories and last not in name_ends
 
 
 def _seen_names(context: PlanningContext) -> list[str]:

@@ -9,8 +9,8 @@ words worlds use, and keeps the other word lists the reader needs
 Where a word here names a category a world does not use, it simply matches
 nothing in that world.
 
-The entries are synonyms and hypernyms as a thesaurus (WordNet) gives them,
-chosen for requests made of a home robot; misspellings are not listed here
+The entries are synonyms and broader terms, chosen by hand for requests made
+of a home robot (WordNet's relations miss most household categories); misspellings are not listed here
 (``reading.py`` corrects them against the vocabulary).
 """
 

@@ -45,7 +45,6 @@ class Wanted:
     items: list[Item]
     exclude: str = ""  # "anything but the apple": "apple"
     source: str | None = None  # the surface they come from ("the coke on the table")
-    words: str = ""
 
     @property
     def simple(self) -> bool:
@@ -57,7 +56,7 @@ class Wanted:
 def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
     """Read an object phrase; ``surfaces``: words → surface name (for "from the far counter")."""
     text = " ".join(phrase.split())
-    wanted = Wanted(items=[], words=text)
+    wanted = Wanted(items=[])
     text, wanted.source = _source(text, surfaces)
     excluded = EXCLUSION.search(text)
     if excluded is not None:  # "anything but the apple", "a drink that is not fizzy", "not the apple"
