@@ -34,6 +34,15 @@ def known() -> frozenset[str]:
         ("1. go to the table 2. pick up the coke", ["go to the table", "pick up the coke"]),
         ("how would you recycle the 7 up can?", ["recycle the 7up can"]),
         ("my desk is sticky, help", ["my desk is sticky", "bring me something to clean with"]),
+        ("the coke, bring it here", ["bring the coke here"]),
+        ("the apple on the table – compost it", ["compost the apple on the table"]),
+        ("the sponge belongs on the far counter", ["put the sponge on the far counter"]),
+        ("I want the tea taken to the table", ["put the tea to the table"]),
+        ("bring me a snack, anything is fine", ["bring me a snack"]),
+        ("come find me", ["come here"]),
+        ("go and stand by the trash can", ["go by the trash can"]),
+        ("is there anything I can eat?", ["bring me something to eat"]),
+        ("I'm off sugar, anything to drink?", ["anything to drink without sugar"]),
     ],
 )
 def test_requests_are_read_into_plain_clauses(known, text, clauses):

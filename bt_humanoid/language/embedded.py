@@ -23,6 +23,7 @@ language, made of the library's behaviours:
 
 from __future__ import annotations
 
+import itertools
 import re
 import time
 from dataclasses import dataclass, field
@@ -165,6 +166,7 @@ class EmbeddedPlanner:
         clauses = read(text, known_words(context))
         if replace is not None:
             clauses = [_replace_phrase(clause, *replace) for clause in clauses]
+        clauses = _fetched_to_put(clauses)
         if not clauses:
             return Plan("refusal", "I did not hear a command.")
         state = _State.at_start(context)
@@ -307,12 +309,15 @@ class EmbeddedPlanner:
         dropped_elsewhere = verb == "drop" and not (
             _is_bin_phrase(rest, context) or re.match(r"^(?:it|them)?\s*in", rest)
         )
+        taking = {"bring_me", "take", "carry_to_surface"} & set(kinds)
+        if taking and re.match(r"^(?:everything|all|all the things|the things|stuff) (?:off|from)\s", rest):
+            self._clear(rest, state, context)  # "get everything off the table"
+            return "clear"
         if "throw_away" in kinds and not tossed_to_me and not dropped_elsewhere:
             self._throw(verb, rest, state, context)
             return "throw_away"
-        if "clear" in kinds and (
-            not rest or _destination(re.sub(r"^(?:off|up|everything off|all)\s+", "", rest), context)
-        ):
+        cleared = re.sub(r"^(?:off|up|(?:everything|all|things|stuff) (?:off|on|from))\s+", "", rest)
+        if "clear" in kinds and (not rest or _destination(cleared, context)):
             self._clear(rest, state, context)
             return "clear"
         if "clear" in kinds:  # "tidy the chips away (onto the counter)": put it away, or back where it belongs
@@ -465,7 +470,9 @@ class EmbeddedPlanner:
         words = re.sub(r"^(?:off|up)\s+", "", words)
         surface = WorldVocabulary.of(context.world).surface(_bare(words))
         if surface is None:
-            raise PlanRefused(f"I can clear a surface: the {_surfaces(context)}.")
+            refusal = NotUnderstood if not _bare(words) else PlanRefused  # a bare "tidy up" before the details
+            raise refusal(f"I can clear a surface: the {_surfaces(context)}.")
+        state.counted = True  # everything on it: what was seen from afar may not be all
         on_it = [o for o in context.belief.present() if o.held_by is None and _on_surface(o, surface, context)]
         if not on_it:
             state.lines.append(f"find the {_spoken(surface)} already clear")
@@ -786,6 +793,9 @@ class EmbeddedPlanner:
             for p in pool:
                 distinct.setdefault(of[p], p)
             pool = list(distinct.values()) if listed.different else pool
+        held = [o for o in seen if o.held_by is not None]
+        if count == 1 and listed.definite and not listed.every and held:  # "put that bottle down" holding one
+            return [_one_of(held[0], context) if specific else _name_of(held[0], context)]
         if count == 1 and listed.definite and not is_open(item) and name is None:
             options = list(dict.fromkeys(of[p] for p in pool))
             if len(options) > 1:  # "the caffeinated one" names one thing, and several fit: ask
@@ -843,6 +853,20 @@ def _back(words: str, context: PlanningContext) -> str | None:
         if _destination(after, context) is None:
             return (words[: match.start()] + " " + words[match.end() :]).strip()
     return None
+
+
+def _fetched_to_put(clauses: list[str]) -> list[str]:
+    """ "fetch the apple and chuck it in the compost": the thing is fetched to go somewhere else, not to me."""
+    out = list(clauses)
+    moving = set(INTENTS["put"].verbs) | set(INTENTS["throw_away"].verbs)
+    for i, (clause, following) in enumerate(itertools.pairwise(clauses)):
+        verb, rest = _verb_of(clause)
+        then, then_rest = _verb_of(following)
+        to_someone = re.search(r"\b(?:me|us|here|you)\b", rest)
+        acts_on_it = re.match(r"^(?:it|them|those|that)\b", then_rest)
+        if verb in BRING_ONLY and then in moving and not to_someone and acts_on_it:
+            out[i] = f"take {rest}"
+    return out
 
 
 def _verb_of(clause: str) -> tuple[str | None, str]:

@@ -123,6 +123,8 @@ KIND_SYNONYMS: dict[str, str] = {
     "tin": "can",
     "tins": "can",
     "bottles": "bottle",
+    "bottled": "bottle",
+    "canned": "can",
     "bags": "bag",
     "packet": "bag",
     "packets": "bag",
@@ -201,6 +203,8 @@ FRAMING = (
 )
 # asking for a thing by wanting it: "i'd like the apple" is "bring me the apple"
 WANTING = (
+    "i fancy",
+    "fancy",
     "i would like",
     "i would love",
     "i want",

@@ -46,8 +46,11 @@ MID_FILLER = re.compile(  # words that say nothing wherever they stand
     r"\b(?:when you get there|once you get there|once you are there|when you are there|while you are there|"
     r"while you are at it|once there|one by one|one at a time|in turn)\b"
 )
+BOTH_AND = re.compile(  # "both the coke and the pepsi", "both coke and pepsi"; not "both sparkling waters and …"
+    r"\bboth\s+(?=the\s+[a-z0-9 -]+?\s+and\s+|[a-z0-9 -]*?[a-z0-9-]*[^s\s]\s+and\s+)"
+)
 HOW_WOULD_YOU = re.compile(r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b", re.IGNORECASE)
-SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
+SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>|-+)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
 STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\d+[.)]?|[a-z][.)])\s+")
 MIN_TYPO_LENGTH = 3  # shorter words are too often other words
 TYPO_SCORE = 78.0  # rapidfuzz ratio (0-100) from which a word is taken for a known one
@@ -62,6 +65,7 @@ SUBJECTS = re.compile(
 
 def read(text: str, known: frozenset[str]) -> list[str]:
     """The clauses of a request, each plain and corrected; ``known``: the words the robot knows (``known_words``)."""
+    text = re.sub(r"\s*[–—]\s*", " - ", text)  # a dash between clauses, before the dashes are dropped as non-ASCII
     text = unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode()  # jalapeño → jalapeno
     text = text.replace("’", "'").replace("->", " -> ").replace("→", " -> ")
     text = HOW_WOULD_YOU.sub(" ", text)  # "how would you …" asks for the plan: the planner explains and does it
@@ -76,18 +80,23 @@ def read(text: str, known: frozenset[str]) -> list[str]:
         plain = " ".join(w for w in words if w)
         plain = _joined(" ".join(correct(word, known) for word in plain.split()), known)
         plain = MID_FILLER.sub(" ", plain).strip()
+        plain = BOTH_AND.sub("", plain)  # "both the coke and the pepsi": the two named
+        plain = re.sub(r"(?<=\w )what(?:ever)?(?: is| there is)?(?= (?:on|in|at|from|off)\b)", "everything", plain)
         pieces: list[str] = []
-        for piece in re.split(r"\s*,\s*", plain):  # a comma ends a clause before a verb or an aside only
+        # a comma ends a clause before a verb or an aside only; "X goes to A and Y to B" is two
+        for piece in (part for chunk in re.split(r"\s*,\s*", plain) for part in BELONGS_BREAK.split(chunk)):
             piece = unframe(piece)
             if not piece:
                 continue
+            if pieces and ANY_WILL_DO.match(piece) and re.search(r"\b(?:a|an|some|something|anything)\b", pieces[-1]):
+                continue  # "get me a drink, any drink": any one will do
             if pieces and not starts_clause(piece) and not is_context(piece) and not is_context(pieces[-1]):
                 pieces[-1] += " , " + piece
             else:
                 pieces.append(piece)
         clauses += [clause for piece in _in_order(pieces) for clause in split_clauses(piece)]
     clauses = [unframe(clause) for clause in clauses if unframe(clause)]
-    clauses = _in_order(clauses)
+    clauses = _avoiding(_topic_first(_in_order(clauses)))
     if clauses and all(is_context(c) for c in clauses):  # "my desk is sticky, help": the trouble says what
         trouble = next((TROUBLES[w] for c in clauses for w in c.split() if w in TROUBLES), None)
         if trouble is not None:
@@ -122,6 +131,55 @@ def _in_order(clauses: list[str]) -> list[str]:
         out += later
         later = []
     return out + later
+
+
+ANY_WILL_DO = re.compile(
+    r"^(?:any|anything|whatever|whichever)\b(?:\s+\w+)?(?:\s+(?:is fine|will do|works|you like))?$"
+)
+PRONOUN = re.compile(r"\b(?:it|them)\b")
+DESTINATION_WORDS = re.compile(r"\b(?:to|into|onto|towards?)\b")
+
+
+def _topic_first(clauses: list[str]) -> list[str]:
+    """A thing named first and then acted on as "it": "the coke, bring it here" → "bring the coke here"."""
+    out: list[str] = []
+    for clause in clauses:
+        topic = out[-1] if out else None
+        if (
+            topic is not None
+            and not starts_clause(topic)
+            and not is_context(topic)
+            and not DESTINATION_WORDS.search(topic)
+            and not PRONOUN.search(topic)
+            and starts_clause(clause)
+            and PRONOUN.search(clause)
+        ):
+            out[-1] = PRONOUN.sub(topic.replace("\\", ""), clause, count=1)
+        else:
+            out.append(clause)
+    return out
+
+
+OFF = re.compile(  # "i'm off sugar this month": what is asked for next must be without it
+    r"^(?:i am|we are|i have gone|we have gone|i went|i have been|i) (?:off|avoiding|cutting out|staying off|"
+    r"not (?:having|drinking|eating))\s+(?P<what>.+?)(?:\s+(?:this|for|at|right|these)\b.*)?$"
+)
+OPEN_REQUEST = re.compile(r"\b(?:something|anything|a drink|a snack|some\s+\w+)\b")
+
+
+def _avoiding(clauses: list[str]) -> list[str]:
+    """ "i'm off sugar and caffeine, anything i can drink?": the open request after it is made "without" them."""
+    out: list[str] = []
+    avoid: str | None = None
+    for clause in clauses:
+        off = OFF.match(clause)
+        if off is not None:
+            avoid = off["what"]
+            continue
+        if avoid is not None and OPEN_REQUEST.search(clause) and " without " not in clause:
+            clause = f"{clause} without {avoid}"
+        out.append(clause)
+    return out
 
 
 def _base_form(clause: str) -> str:
@@ -187,6 +245,30 @@ NEED_REQUESTS = {f"bring me {wanted}": wanted for wanted in NEEDS.values()}
 WOULD_BE = re.compile(
     r"^(?P<what>(?:some|a|an|something|anything)\b.*?)\s+(?:would|will|could)\s+(?:be|do|hit the spot)\b.*$"
 )
+BELONGS = re.compile(  # "the water bottle needs to go on the table", "the apple belongs in the compost"
+    r"^(?P<what>.+?)\s+(?:needs? to|has to|have to|should|must|ought to|can|could|will|would|is to)?\s*"
+    r"(?:go|goes|belongs?|be put|be placed|be moved|be kept|live|lives|stay|stays)\s+"
+    r"(?P<where>(?:back\s+)?(?:on|in|into|onto|on top of|to|inside|over on|next to|by)\s+.+)$"
+)
+PEOPLE_AND_THEN = r"^(?:i|we|you|he|she|they|someone|somebody)\b|\bthen\b"
+# "the kettle chips go to the close counter and the rice chips go to the table": two requests
+BELONGS_BREAK = re.compile(
+    r"\s+(?:and|,)\s+(?=[a-z0-9 -]+?\s+(?:needs? to |has to |should |must )?(?:go|goes|belongs?)\s+"
+    r"(?:back\s+)?(?:on|in|into|onto|to|inside)\b)"
+)
+COME_TO_ME = re.compile(r"^(?:come|go)(?: and)? (?:find|see|join|get) (?:me|us)$|^find me$")
+GO_AND_STAY = re.compile(r"^(?P<go>go|come|head)(?: and| over and| over)? (?:stand|wait|park|stay|sit|hang out|be)\b")
+ANYTHING_TO = re.compile(
+    r"^(?:is there|have you got|have we got|do you have|do we have|got)\s+(?:anything|something)\s+"
+    r"(?:(?:that\s+)?(?:i|we)\s+(?:can|could)\s+|to\s+)(?P<verb>drink|eat|snack on|have)\b"
+)
+PARTICIPLES = {
+    **dict.fromkeys(("moved", "put", "placed", "taken", "carried", "brought", "set", "left"), "put"),
+    **dict.fromkeys(("thrown", "binned", "tossed", "chucked", "dumped"), "throw"),
+    "recycled": "recycle",
+    "composted": "compost",
+}
+DONE_TO = re.compile(r"^(?P<what>.+?)\s+(?P<done>" + "|".join(PARTICIPLES) + r")\b\s*(?P<rest>.*)$")
 NEED = re.compile(
     r"^(?:i am|we are|i feel|feeling|i get|getting)\s+(?:so\s+|really\s+|absolutely\s+|a bit\s+|kinda\s+)*(?P<need>"
     + "|".join(NEEDS)
@@ -204,6 +286,17 @@ def unframe(clause: str) -> str:
         clause = FRAMING_AT_START.sub("", clause).strip()
         if not re.match(r"^(?:say|tell|announce)\b", clause):  # what is to be said stays as it is
             clause = FRAMING_AT_END.sub("", clause).strip()
+    belongs = BELONGS.match(clause)
+    if belongs is not None and not starts_clause(belongs["what"]) and not re.search(PEOPLE_AND_THEN, belongs["what"]):
+        if re.match(r"^(?:in|into|to) (?:my|our) hands?$|^to (?:me|us)$", belongs["where"]):
+            return f"bring me {belongs['what']}"
+        return f"put {belongs['what']} {belongs['where']}"
+    if COME_TO_ME.match(clause):
+        return "come here"
+    clause = GO_AND_STAY.sub(lambda m: m["go"], clause)  # "go stand by the bin"
+    anything = ANYTHING_TO.match(clause)
+    if anything is not None:  # "is there anything i can drink?"
+        return f"bring me something to {anything['verb']}"
     would = WOULD_BE.match(clause)
     if would is not None:
         return f"bring me {would['what']}"
@@ -214,6 +307,9 @@ def unframe(clause: str) -> str:
     if wanted is not None and clause[wanted.end() :].strip():
         rest = clause[wanted.end() :].strip()
         rest = re.sub(r"^(?:you to|to have|to)\s+", "", rest)
+        done = DONE_TO.match(rest)
+        if done is not None:  # "i want the chips moved to the table"
+            return f"{PARTICIPLES[done['done']]} {done['what']} {done['rest']}".strip()
         return rest if _starts_with_verb_like(rest) else f"bring me {rest}"
     return _gerund(clause)
 

@@ -68,12 +68,12 @@ INTENTS: dict[str, Intent] = {
     # "carry X to the counter" (put) and "carry X to me" (bring): the same verbs when typed
     "carry_to_surface": Intent(
         ("move", "take", "carry"),
-        ("bring", "fetch", "get", "hand", "give", "pass", "deliver", "relocate", "shift", "transfer", "return"),
+        ("bring", "fetch", "get", "hand", "give", "pass", "deliver", "relocate", "shift", "transfer", "return", "run"),
         ("fetch", "navigate", "place"),
     ),
     "carry_to_person": Intent(
         ("bring", "take", "carry"),
-        ("fetch", "get", "hand", "give", "pass", "move", "deliver"),
+        ("fetch", "get", "hand", "give", "pass", "move", "deliver", "run"),
         ("take", "navigate", "give"),
     ),
     "bring_here": Intent((), ("bring", "fetch"), ("take", "navigate", "give")),  # "bring the mug here"
@@ -91,7 +91,10 @@ INTENTS: dict[str, Intent] = {
     "come": Intent(("come here", "come to me"), ("come", "come over here", "come back", "return to me"), ("navigate",)),
     "go": Intent(
         ("go", "walk", "drive", "head", "navigate"),
-        ("move", "come", "return", "get", "park", "visit", "stop by", "swing by", "roll", "do a lap", "make your way"),
+        (
+            *("move", "come", "return", "get", "park", "visit", "stop by", "swing by", "roll", "do a lap"),
+            *("make your way", "approach", "check on", "check", "run", "pop over", "nip over"),
+        ),
         ("navigate", "find"),
     ),
     "go_home": Intent(
