@@ -135,9 +135,12 @@ def test_fetch_carries_the_mug_from_the_counter_to_the_shelf():
     run = build_run(mission, robot_start=(7.0, 2.4, 0.0))  # in the kitchen: the drive to the shelf is clear
     scenario = Scenario(run, run.execute())
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
+    # the spot asked for is 5 cm from the yellow ball: the mug goes down beside it, and the ball stays put
     x, y, _ = scenario.truth.object_position("coffee mug")
-    assert np.hypot(x - 1.2, y - 4.2) < 0.03
+    assert 0.05 < np.hypot(x - 1.2, y - 4.2) < 0.15
     assert scenario.truth.rests_on("coffee mug", "shelf")
+    ball = scenario.truth.object_position("yellow ball")
+    assert np.hypot(ball[0] - 1.2, ball[1] - 4.15) < 0.01
     assert scenario.truth.upright("coffee mug")
 
 
@@ -158,7 +161,7 @@ def test_grasp_moves_a_hand_that_hides_the_object_before_it_looks():
     scenario = Scenario(run, run.execute())
     assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
     grasp = [e.get("feedback", "") for e in scenario.events if e.get("node", "").endswith("grasp")]
-    assert any(f.startswith("clear the view: reaching") for f in grasp), grasp
+    assert any(f.startswith(("clear the view: reaching", "step aside: reaching")) for f in grasp), grasp
     assert scenario.truth.in_hand("coffee mug")
 
 

@@ -42,3 +42,35 @@ def free_spot(
         if len(candidates):
             return candidates[int(np.argmin(np.linalg.norm(candidates - np.array([ax, ay]), axis=1)))]
     return None
+
+
+MAX_SHIFT = 0.15  # m a spot asked for may move to clear what stands there
+PLACE_GAP = 0.02  # m between a thing put down and its neighbours
+EDGE_MARGIN = 0.05  # m a spot keeps from the surface's edge
+
+
+def nearest_free(
+    surface: SupportSurface, belief: WorldModel, spot: np.ndarray, radius: float, exclude: tuple[str, ...] = ()
+) -> np.ndarray | None:
+    """``spot`` if a thing ``radius`` round fits there clear of what is believed on ``surface``; else the nearest
+    spot within ``MAX_SHIFT`` that does, on the surface; None if there is none."""
+    others = [
+        (o.position[:2], float(np.hypot(o.size[0], o.size[1])) / 2)
+        for o in belief.present()
+        if o.held_by is None and o.id not in exclude and surface.contains(o.position[:2])
+    ]
+
+    def free(xy: np.ndarray) -> bool:
+        inside = surface.contains(xy, margin=min(radius, EDGE_MARGIN))
+        return inside and all(np.hypot(*(xy - c)) >= radius + r + PLACE_GAP for c, r in others)
+
+    spot = np.asarray(spot, dtype=float)[:2]
+    if free(spot):
+        return spot
+    angles = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    for shift in np.arange(0.01, MAX_SHIFT + 1e-9, 0.01):
+        ring = spot + shift * np.column_stack([np.cos(angles), np.sin(angles)])
+        fits = [xy for xy in ring if free(xy)]
+        if fits:
+            return fits[0]
+    return None

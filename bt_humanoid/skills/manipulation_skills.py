@@ -15,10 +15,19 @@ import pinocchio as pin
 from pydantic import Field, model_validator
 
 from bt_humanoid.control.grasping import LIFT_HEIGHT, PAD_HALF_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
+from bt_humanoid.control.keep_clear import (
+    clearance_limits,
+    footprint_radius,
+    hand_radius,
+    over_limit,
+    things_on,
+    transit_height,
+)
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.control.wbc.limits import BaseBoundsLimit, BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
+from bt_humanoid.perception.free_space import EDGE_MARGIN, MAX_SHIFT, nearest_free
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.skills.context import CheckContext
 from bt_humanoid.skills.params import check_in_map, check_name, check_object
@@ -40,6 +49,7 @@ MAX_CARRY_HEIGHT = 1.2  # m: the arm's comfortable limit (torso lifted)
 CARRY_TOLERANCE = (0.05, 0.2)  # m, rad: the carry pose needs no precision (a tall thing held high may fall short)
 IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (and not behind it) hides part of it
 BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its line of sight is behind it
+ASIDE = 0.18  # m a hand in the camera's way moves outwards: out of a 20° cone at the arm's usual reach
 
 
 class _ManipulationSkill(PhasedSkill):
@@ -63,22 +73,81 @@ class _ManipulationSkill(PhasedSkill):
         rotation = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side)).rotation
         return math.atan2(rotation[1, 0], rotation[0, 0])
 
+    def _carry_xy(self, side: str) -> np.ndarray:
+        """Where the carry pose holds the hand, in the plane: ahead of the base, outside the shoulder."""
+        x, y, yaw = self.context.robot.base.pose()
+        lateral = -CARRY_SIDE if side == "right" else CARRY_SIDE
+        forward = np.array([math.cos(yaw), math.sin(yaw)])
+        left = np.array([-math.sin(yaw), math.cos(yaw)])
+        return np.array([x, y]) + CARRY_FORWARD * forward + lateral * left
+
+    def _is_open(self, side: str) -> bool:
+        gripper = self.context.robot_config.grippers[side]
+        return self.context.robot.grippers.width(side) > len(gripper.joints) * gripper.open / 2
+
+    def _hand_extent(self, side: str) -> tuple[float, float]:
+        """How far below the grip site, and how far across, the hand or what it holds reaches (m)."""
+        held = self.context.world_model.held(side)
+        if held is not None:
+            return held.grip_offset + float(held.size[2]) / 2, hand_radius(held, is_open=False)
+        return PAD_HALF_HEIGHT, hand_radius(None, self._is_open(side))
+
+    def _hand_xyz(self, side: str) -> np.ndarray:
+        whole_body = self.context.robot.whole_body
+        return whole_body.frame_pose(whole_body.hand_frame(side)).translation.copy()
+
+    def _keep_clear(
+        self, side: str, surface: SupportSurface, exclude: tuple[str, ...] = (), except_at: np.ndarray | None = None
+    ) -> list[ClearanceLimit]:
+        """Limits holding the hand (and what it holds) above each thing believed on ``surface``."""
+        things = things_on(self.context.world_model, surface, exclude)
+        frame = self.context.robot.whole_body.hand_frame(side)
+        return clearance_limits(frame, things, *self._hand_extent(side), except_at=except_at)
+
+    def _rise_over(
+        self,
+        side: str,
+        surface: SupportSurface,
+        goal_xy: np.ndarray,
+        at_least: float,
+        exclude: tuple[str, ...] = (),
+        start_xy: np.ndarray | None = None,
+    ) -> MotionHandle | None:
+        """Lift the hand straight up until a straight move to ``goal_xy`` (from ``start_xy``, default where the
+        hand is) passes over the things on ``surface``, and to ``at_least``; nothing when it is that high already."""
+        hand = self._hand_xyz(side)
+        start = hand[:2] if start_xy is None else start_xy
+        things = things_on(self.context.world_model, surface, exclude)
+        height = max(at_least, transit_height(start, goal_xy, things, *self._hand_extent(side)))
+        if hand[2] >= height - 0.02:
+            return None
+        whole_body = self.context.robot.whole_body
+        rotation = whole_body.frame_pose(whole_body.hand_frame(side)).rotation.copy()
+        target = pin.SE3(rotation, np.array([hand[0], hand[1], min(height, MAX_CARRY_HEIGHT)]))
+        # an open hand keeps its wrist where the spread fingers clear the forearm; a closed one may go higher
+        open_hand = self._open_hand(side) if self._is_open(side) else []
+        # as high as the arm goes here: close to the body it may stop a few centimetres short, and the next
+        # reach's clearance limits lift it the rest of the way as it moves out over the things
+        return whole_body.reach(side, target, move_base=False, limits=open_hand, tolerance=CARRY_TOLERANCE)
+
     def _carry(self, side: str, clearances: list[ClearanceLimit]) -> MotionHandle:
         """Bring the hand in front of the body, high enough to carry what it holds past furniture.
 
         ``clearances`` hold the hand up while it is over a surface; the carry
         pose is at least as high as each, since it may lie over the surface's edge.
+        The hand also keeps above each thing on the surface it starts over.
         """
-        x, y, yaw = self.context.robot.base.pose()
-        lateral = -CARRY_SIDE if side == "right" else CARRY_SIDE
-        forward = np.array([math.cos(yaw), math.sin(yaw)])
-        left = np.array([-math.sin(yaw), math.cos(yaw)])
-        xy = np.array([x, y]) + CARRY_FORWARD * forward + lateral * left
+        yaw = self.context.robot.base.pose()[2]
+        xy = self._carry_xy(side)
         # high enough that what hangs below the hand clears every known surface on the way
         held = self.context.world_model.held(side)
         below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
+        n_given = len(clearances)
+        under = self.context.world_model.surface_under(self._hand_xyz(side))
+        if under is not None:
+            clearances = [*clearances, *self._keep_clear(side, under)]
         highest = max((s.height for s in self.context.world_model.surfaces.values()), default=0.0)
-        height = max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE, *(c.height for c in clearances))
+        height = max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE, *(c.height for c in clearances[:n_given]))
         # an empty hand turns to its natural yaw; a full one keeps its yaw (as grasped) so nothing swings
         hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(yaw)
         target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, min(height, MAX_CARRY_HEIGHT)]))
@@ -130,6 +199,7 @@ class StandNear(_ManipulationSkill):
         return [
             ("tuck the other arm", self._tuck),
             ("raise the arm", self._raise_arm),
+            ("hand up", self._hand_up),
             ("stance", self._drive),
         ]
 
@@ -142,15 +212,21 @@ class StandNear(_ManipulationSkill):
         ready = config.postures.get(READY_POSTURE, {})
         return self.context.robot.joints.move({j: ready[j] for j in joints if j in ready})
 
-    def _tuck(self) -> MotionHandle:
-        """Fold the idle arm inside the footprint, where no furniture edge can catch it."""
-        config = self.context.robot_config
-        other = "left" if self.params.side == "right" else "right"
-        joints = config.groups.get(f"{other}_arm", [])
-        tucked = config.postures.get(TUCKED_POSTURE, {})
-        return self.context.robot.joints.move({j: tucked[j] for j in joints if j in tucked})
+    def _hand_up(self) -> MotionHandle | None:
+        """Raise the empty hand, held out at the ready posture, over the things it will pass as the base drives
+        to the stance: at the ready height it would sweep through a bag of chips beside the object."""
+        side = self.params.side
+        if self.context.world_model.held(side) is not None:
+            return None
+        surface, stance = self._stance()
+        x, y, yaw = self.context.robot.base.pose()
+        hand = self._hand_xyz(side)
+        offset = yaw_rotation(-yaw)[:2, :2] @ (hand[:2] - np.array([x, y]))  # the hand in the base's frame
+        arrived = stance[:2] + yaw_rotation(stance[2])[:2, :2] @ offset
+        return self._rise_over(side, surface, arrived, hand[2], start_xy=hand[:2])
 
-    def _drive(self) -> MotionHandle:
+    def _stance(self) -> tuple[SupportSurface, np.ndarray]:
+        """The surface worked on and the base pose (x, y, yaw) to work on it from."""
         p: StandNearParams = self.params
         belief = self.context.world_model
         if p.object is not None:
@@ -164,7 +240,7 @@ class StandNear(_ManipulationSkill):
             spot = np.array(p.at) if p.at is not None else surface.region.mean(axis=0)
         config = self.context.robot_config
         try:
-            x, y, yaw = stance_for(
+            pose = stance_for(
                 spot,
                 surface,
                 p.side,
@@ -174,6 +250,19 @@ class StandNear(_ManipulationSkill):
             )
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
+        return surface, np.array(pose)
+
+    def _tuck(self) -> MotionHandle:
+        """Fold the idle arm inside the footprint, where no furniture edge can catch it."""
+        config = self.context.robot_config
+        other = "left" if self.params.side == "right" else "right"
+        joints = config.groups.get(f"{other}_arm", [])
+        tucked = config.postures.get(TUCKED_POSTURE, {})
+        return self.context.robot.joints.move({j: tucked[j] for j in joints if j in tucked})
+
+    def _drive(self) -> MotionHandle:
+        p: StandNearParams = self.params
+        _surface, (x, y, yaw) = self._stance()
         if self._straight_way_blocked(np.array([x, y])):  # the object moved, or we stand on another side
             return self.context.navigator.go_to(np.array([x, y, yaw]), p.max_speed)
         return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed)
@@ -217,6 +306,7 @@ class Grasp(_ManipulationSkill):
     def phases(self):
         return [
             ("clear the view", self._clear_view),
+            ("step aside", self._step_aside),
             ("plan", self._plan),
             ("raise", self._raise),
             ("pre-grasp", self._pre_grasp),
@@ -228,27 +318,47 @@ class Grasp(_ManipulationSkill):
             ("carry", lambda: self._carry(self.params.side, [self._clearance(self.params.side, self.surface, 0.0)])),
         ]
 
-    def _clear_view(self) -> MotionHandle | None:
-        """Move the empty hand out of the camera's line of sight to the object before the close look.
+    def _in_view(self) -> bool:
+        """Is the hand on the camera's line of sight to the object (and not behind it)?
 
         A hand over the object (after a failed attempt) or beside it (the ready posture) hides part of it: the
         rest reads as a smaller thing off-centre, and the cut edge can pass for a mug's handle.
         """
-        side = self.params.side
-        if self.context.perceiver is None or self.context.world_model.held(side) is not None:
-            return None
         target = self._object(self.params.object)
         whole_body = self.context.robot.whole_body
         eye = whole_body.frame_pose(self.context.robot_config.frames["head_camera"][1]).translation
-        to_hand = whole_body.frame_pose(whole_body.hand_frame(side)).translation - eye
+        to_hand = self._hand_xyz(self.params.side) - eye
         to_object = target.position - eye
         cosine = float(to_hand @ to_object) / max(float(np.linalg.norm(to_hand) * np.linalg.norm(to_object)), 1e-9)
         behind = np.linalg.norm(to_hand) > np.linalg.norm(to_object) + BEHIND_MARGIN
-        if cosine < math.cos(IN_THE_WAY) or behind:
+        return cosine >= math.cos(IN_THE_WAY) and not behind
+
+    def _clear_view(self) -> MotionHandle | None:
+        """Before the close look, lift an empty hand that is in the camera's way over the things near it ..."""
+        side = self.params.side
+        self._hidden = (
+            self.context.perceiver is not None and self.context.world_model.held(side) is None and self._in_view()
+        )
+        if not self._hidden:
             return None
-        surface = self.context.world_model.surface_under(target.position)
-        clearances = [self._clearance(side, surface, 0.0)] if surface is not None else []
-        return self._carry(side, clearances)
+        hand = self._hand_xyz(side)
+        surface = self.context.world_model.surface_under(hand)
+        return self._rise_over(side, surface, hand[:2], hand[2]) if surface is not None else None
+
+    def _step_aside(self) -> MotionHandle | None:
+        """... and then move it outwards, away from the body's centre line, until it no longer hides the object."""
+        if not self._hidden:
+            return None
+        side = self.params.side
+        yaw = self.context.robot.base.pose()[2]
+        outwards = np.array([math.sin(yaw), -math.cos(yaw)]) * (1.0 if side == "right" else -1.0)
+        hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(side))
+        target = pin.SE3(hand.rotation.copy(), hand.translation + np.array([*(ASIDE * outwards), 0.0]))
+        under = self.context.world_model.surface_under(hand.translation)
+        limits = self._keep_clear(side, under) if under is not None else []
+        return self.context.robot.whole_body.reach(
+            side, target, move_base=False, limits=limits, tolerance=CARRY_TOLERANCE
+        )
 
     def _plan(self) -> None:
         side = self.params.side
@@ -274,26 +384,19 @@ class Grasp(_ManipulationSkill):
         return pin.SE3(yaw_rotation(self.grasp.yaw), position)
 
     def _raise(self) -> MotionHandle | None:
-        """Lift the hand straight up to the pre-grasp height first, so it clears the surface's edge."""
-        whole_body = self.context.robot.whole_body
-        hand = whole_body.frame_pose(whole_body.hand_frame(self.params.side)).translation
-        if hand[2] >= self.grasp.pre_grasp[2] - 0.02:
-            return None
-        self.context.robot.grippers.command(self.params.side, "open")
-        target = np.array([hand[0], hand[1], self.grasp.pre_grasp[2]])
-        return whole_body.reach(
-            self.params.side,
-            self._pose(target),
-            move_base=False,
-            limits=self._open_hand(self.params.side),
-            tolerance=CARRY_TOLERANCE,
-        )
+        """Lift the hand straight up first: to the pre-grasp height, so it clears the surface's edge, and over
+        the things between it and the object."""
+        side, goal = self.params.side, self.grasp.pre_grasp  # the hand opens on its way to the pre-grasp
+        return self._rise_over(side, self.surface, goal[:2], goal[2], exclude=(self.target.id,))
 
     def _pre_grasp(self) -> MotionHandle:
         robot = self.context.robot
         robot.grippers.command(self.params.side, "open")  # opens while the hand travels
         limits = [*self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, 0.0)]
         limits += self._open_hand(self.params.side)
+        limits += self._keep_clear(self.params.side, self.surface, (self.target.id,), except_at=self.grasp.pre_grasp)
+        # the pads pass over the object's own top on the way (a bag of chips tips at a touch)
+        limits.append(over_limit(robot.whole_body.hand_frame(self.params.side), self.target, PAD_HALF_HEIGHT, margin=0))
         return robot.whole_body.reach(
             self.params.side, self._pose(self.grasp.pre_grasp), gaze=self.target.position, limits=limits
         )
@@ -323,10 +426,16 @@ class Grasp(_ManipulationSkill):
         self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
 
     def _lift(self) -> MotionHandle:
+        # high enough that what the hand now holds passes over the things between here and the carry pose
+        side = self.params.side
+        things = things_on(self.context.world_model, self.surface, (self.target.id,))
+        over = transit_height(self.grasp.position[:2], self._carry_xy(side), things, *self._hand_extent(side))
+        lifted = self.grasp.lifted.copy()
+        lifted[2] = min(max(lifted[2], over), MAX_CARRY_HEIGHT)
         # the base may help a stretched arm up, but not by driving under the surface's edge
         return self.context.robot.whole_body.reach(
-            self.params.side,
-            self._pose(self.grasp.lifted),
+            side,
+            self._pose(lifted),
             speed=DESCEND_SPEED,
             limits=self._keepout(self.surface.region),
         )
@@ -379,6 +488,7 @@ class Put(_ManipulationSkill):
     def phases(self):
         return [
             ("plan", self._plan),
+            ("raise", lambda: self._rise_over(self.params.side, self.surface, self.release[:2], 0.0)),
             ("above the spot", self._above),
             ("lower", self._lower),
             ("release", self._release),
@@ -398,8 +508,16 @@ class Put(_ManipulationSkill):
             spot = np.array(self.params.at, dtype=float)
         else:
             spot = self._spot_ahead(hand.translation[:2])
-        if not self.surface.contains(spot, margin=0.05):
+        if not self.surface.contains(spot, margin=EDGE_MARGIN):
             raise PhaseFailure(f"spot ({spot[0]:.2f}, {spot[1]:.2f}) is not on the {self.surface.name}")
+        # a spot something already stands on (as believed) moves aside to the nearest free one
+        free = nearest_free(self.surface, self.context.world_model, spot, footprint_radius(self.held), (self.held.id,))
+        if free is None:
+            raise PhaseFailure(
+                f"spot ({spot[0]:.2f}, {spot[1]:.2f}) on the {self.surface.name} is taken, and nothing within "
+                f"{MAX_SHIFT * 100:.0f} cm of it is free"
+            )
+        spot = free
         # the hand sits this far above the object's bottom (as grasped)
         self.below_hand = self.held.grip_offset + float(self.held.size[2]) / 2
         release_z = self.surface.height + RELEASE_GAP + self.below_hand
@@ -413,6 +531,7 @@ class Put(_ManipulationSkill):
 
     def _above(self) -> MotionHandle:
         limits = [*self._keepout(self.surface.region), self._clearance(self.params.side, self.surface, self.below_hand)]
+        limits += self._keep_clear(self.params.side, self.surface, except_at=self.release)
         target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, APPROACH_CLEARANCE + 0.02]))
         return self.context.robot.whole_body.reach(self.params.side, target, gaze=self.release, limits=limits)
 
@@ -439,6 +558,10 @@ class Put(_ManipulationSkill):
         """Straight up until the open pads clear the top of what was just put down."""
         top_above_grip = float(self.held.size[2]) - self.below_hand
         rise = max(LIFT_HEIGHT, top_above_grip + PAD_HALF_HEIGHT + APPROACH_CLEARANCE / 2)
+        # and over the things between here and the carry pose
+        things = things_on(self.context.world_model, self.surface, (self.held.id,))
+        over = transit_height(self.release[:2], self._carry_xy(self.params.side), things, PAD_HALF_HEIGHT)
+        rise = min(max(rise, over - self.release[2]), MAX_CARRY_HEIGHT - self.release[2])
         target = pin.SE3(self.rotation, self.release + np.array([0.0, 0.0, rise]))
         return self.context.robot.whole_body.reach(
             self.params.side, target, speed=DESCEND_SPEED, move_base=False, tolerance=CARRY_TOLERANCE

@@ -25,6 +25,8 @@ from bt_humanoid.strict_model import StrictModel, exactly_one
 LOOK_AHEAD_POSTURE = "look_ahead"  # robot.yaml posture: head level, camera on the way ahead
 OBJECT_STANDOFF = 0.35  # m between the footprint and an object on the floor
 PERSON_STANDOFF = 0.6  # m between the footprint and a person: arm's length, to hand things over
+FACING_TURNS = 120  # degrees either side of the robot's own direction where a pose facing someone may be
+FACING_EXTRA = 0.15  # m further off, when no pose at arm's length leaves the base room
 STANCE_BACKOFF = 0.35  # m behind the stance for working on an object on a surface
 BACK_UP_SPEED = 0.2  # m/s
 
@@ -147,12 +149,24 @@ class NavigateTo(_BaseSkill):
             raise PhaseFailure(error.args[0]) from None
 
     def _facing(self, position: np.ndarray, standoff: float) -> np.ndarray:
-        """A pose ``standoff`` from the footprint's edge to ``position``, on the robot's side, facing it."""
+        """A pose ``standoff`` from the footprint's edge to ``position``, facing it: on the robot's side, or as
+        near that side as leaves the base room (a person by a wall or a chair is met from the open side)."""
         here = self.context.robot.base.pose()
         away = here[:2] - position[:2]
-        direction = away / max(float(np.hypot(*away)), 1e-6)
-        xy = position[:2] + (self.context.robot_config.base.footprint_radius + standoff) * direction
-        return np.array([*xy, math.atan2(-direction[1], -direction[0])])
+        towards_robot = math.atan2(away[1], away[0])
+        distance = self.context.robot_config.base.footprint_radius + standoff
+        turns = np.radians(sorted(range(-FACING_TURNS, FACING_TURNS + 1, 15), key=abs))
+        angles = np.concatenate([towards_robot + turns] * 2)
+        radii = np.repeat([distance, distance + FACING_EXTRA], len(turns))
+        xy = position[:2] + radii[:, None] * np.column_stack([np.cos(angles), np.sin(angles)])
+        poses = np.column_stack([xy, np.arctan2(-np.sin(angles), -np.cos(angles))])
+        navigator = self.context.navigator
+        if navigator is not None:
+            room = navigator.grid.clearance_at(poses[:, :2])
+            free = np.flatnonzero(room >= navigator.clearance.minimum)
+            if free.size:
+                return poses[free[0]]
+        return poses[0]
 
     def _standoff(self, name: str) -> np.ndarray:
         """Facing the object: at the nearest edge of the surface it stands on, or beside it on the floor."""
