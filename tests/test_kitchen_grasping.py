@@ -61,9 +61,12 @@ def test_of_the_yaws_that_fit_the_nearest_to_the_hand_wins():
     cube = _thing("cube", (0.05, 0.05, 0.05), yaw=0.3)
     assert plan_grasp(cube, TABLE, 0.0, OPENING).yaw == pytest.approx(0.3)
     assert plan_grasp(cube, TABLE, 1.2, OPENING).yaw == pytest.approx(0.3 + math.pi / 2)
-    sponge = _thing("sponge", (0.095, 0.065, 0.03), yaw=0.0)  # both ways fit: the nearer yaw, not the narrower side
-    assert plan_grasp(sponge, TABLE, 0.2, OPENING).width == pytest.approx(0.095)
+    # both ways fit the sponge, but its 9.5 cm leaves the pads little slack: its 6.5 cm, even at a yaw further off
+    sponge = _thing("sponge", (0.095, 0.065, 0.03), yaw=0.0)
+    assert plan_grasp(sponge, TABLE, 0.2, OPENING).width == pytest.approx(0.065)
     assert plan_grasp(sponge, TABLE, 1.3, OPENING).width == pytest.approx(0.065)
+    wide = _thing("box", (0.095, 0.094, 0.05), yaw=0.0)  # no roomy way: the nearer yaw of the two that fit
+    assert plan_grasp(wide, TABLE, 0.2, OPENING).width == pytest.approx(0.095)
 
 
 def test_a_width_fits_only_with_slack_on_both_sides():

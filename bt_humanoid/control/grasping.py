@@ -10,7 +10,10 @@ chips, bars, sponges), across one pair of its faces.
 
 Of the hand yaws a shape allows, the one nearest the hand's natural yaw whose
 width fits the open gripper with slack to spare wins: a bag of chips 12 cm
-by 5 cm is taken across its 5 cm, whichever way it stands.
+by 5 cm is taken across its 5 cm, whichever way it stands. A width that
+leaves the pads under 2.5 cm of slack each side loses to one that leaves
+more (a sponge 9.5 by 6.5 cm is taken across its 6.5 cm): a pad that lands on
+the object's edge pushes it away.
 
 The grip site goes as high as the palm allows (tall things stay steady),
 never so low that the pads touch the surface, and low enough that the pads
@@ -38,6 +41,7 @@ LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
 # m the open pads must clear the object by, in total: the descent ends within 8 mm of its target and 0.1 rad of
 # its yaw, so a pad 1.5 cm from the object's side cannot land on its top
 OPENING_MARGIN = 0.03
+COMFORTABLE_SLACK = 0.05  # m in total: a width with less slack is taken only when no other fits with more
 
 # hand yaw relative to the base heading that suits either arm best for top-down grasps: the fingers close
 # along the heading, the forearm points forward and the wrist pitches the hand down (see the "ready"
@@ -113,6 +117,7 @@ def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_o
             f"the {obj.name} is {narrowest * 100:.1f} cm across at its narrowest; the gripper opens "
             f"{max_opening * 100:.0f} cm and needs {OPENING_MARGIN * 100:.0f} cm to spare"
         )
-    yaw, width = min(fitting, key=lambda option: abs(wrap_angle(option[0] - hand_yaw)))
+    roomy = [(yaw, width) for yaw, width in fitting if width <= max_opening - COMFORTABLE_SLACK]
+    yaw, width = min(roomy or fitting, key=lambda option: abs(wrap_angle(option[0] - hand_yaw)))
     position = np.array([obj.position[0], obj.position[1], grip_height(obj, support_height)])
     return Grasp(position, yaw, width)

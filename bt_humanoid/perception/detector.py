@@ -58,6 +58,7 @@ class Detection:
     pixels: int
     yaw_known: bool = True  # false for a mug whose handle was not seen (its yaw is a guess)
     occluded: bool = False  # partly hidden behind the robot's own arm: what shows is a cut-off part of it
+    partial: bool = False  # smaller both ways than the thing it is: a part of it shows, its pose is a guess
     identity: str | None = None  # which of the world's objects it is, when a recogniser tells them apart by look
 
 

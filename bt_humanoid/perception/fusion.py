@@ -40,7 +40,7 @@ def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame)
             continue  # a part of something: a later, clear view will say what and where
         if tracked is None:
             tracked = _new(belief, detection, frame.time)
-        elif detection.occluded:
+        elif detection.occluded or detection.partial:  # there, but this view does not say where exactly
             _confirm(tracked, frame.time)
         else:
             _update(tracked, detection, frame.time)

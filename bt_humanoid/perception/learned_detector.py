@@ -42,6 +42,7 @@ from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.sim.world_config import ObjectModel, WorldConfig
 
 MIN_CONFIDENCE = 0.5  # below this the recogniser is not sure enough to name a region
+PARTIAL = 0.8  # of a box's known length and breadth: a top outline shorter both ways is a part of it
 
 
 @dataclass(frozen=True)
@@ -140,10 +141,12 @@ def locate(region: Region, name: str, known: KnownObject, eye: np.ndarray) -> De
     sight /= max(float(np.hypot(*sight)), 1e-9)
     yaw = math.atan2(sight[1], sight[0])
     shape = known.model.shape
+    partial = False
     if shape == "box":
         (cx, cy), (side_a, side_b), angle = cv2.minAreaRect(band.astype(np.float32))
         long_axis = math.radians(angle) + (0.0 if side_a >= side_b else math.pi / 2)
         narrow = min(side_a, side_b)
+        partial = max(side_a, side_b) < PARTIAL * size[0] and narrow < PARTIAL * size[1]
         centre = np.array([cx, cy])
         across_long = np.array([-math.sin(long_axis), math.cos(long_axis)])
         if narrow < size[1]:  # one face seen: the box reaches further from the camera than its visible face
@@ -158,4 +161,6 @@ def locate(region: Region, name: str, known: KnownObject, eye: np.ndarray) -> De
         if not lid and diameter < size[0]:  # the near side of a round thing outlines a circle that is too small
             centre = centre + sight * (size[0] - diameter) / 2
     position = np.array([centre[0], centre[1], surface.height + size[2] / 2])
-    return Detection(known.kind, known.colour, position, size, float(yaw), surface.name, len(points), identity=name)
+    return Detection(
+        known.kind, known.colour, position, size, float(yaw), surface.name, len(points), identity=name, partial=partial
+    )

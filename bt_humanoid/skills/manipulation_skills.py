@@ -29,7 +29,7 @@ from bt_humanoid.control.wbc.limits import BaseBoundsLimit, BaseKeepoutLimit, Cl
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.free_space import EDGE_MARGIN, MAX_SHIFT, nearest_free
 from bt_humanoid.perception.world_model import SupportSurface
-from bt_humanoid.skills.context import CheckContext
+from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.params import check_in_map, check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
@@ -50,6 +50,26 @@ CARRY_TOLERANCE = (0.05, 0.2)  # m, rad: the carry pose needs no precision (a ta
 IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (and not behind it) hides part of it
 BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its line of sight is behind it
 ASIDE = 0.18  # m a hand in the camera's way moves outwards: out of a 20° cone at the arm's usual reach
+
+
+def lift_what_is_held(context: SkillContext) -> MotionHandle | None:
+    """Raise a hand whose load hangs lower than the furniture's tops plus a clearance (as a scene may start a
+    tall bottle held low), before the base drives past the furniture; nothing when every load is clear."""
+    belief = context.world_model
+    highest = max((s.height for s in belief.surfaces.values()), default=0.0)
+    whole_body = context.robot.whole_body
+    for side in context.robot_config.grippers:
+        held = belief.held(side)
+        if held is None:
+            continue
+        below_hand = held.grip_offset + float(held.size[2]) / 2
+        needed = max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE)
+        hand = whole_body.frame_pose(whole_body.hand_frame(side))
+        if hand.translation[2] >= needed - 0.02:
+            continue
+        target = pin.SE3(hand.rotation.copy(), np.array([*hand.translation[:2], min(needed, MAX_CARRY_HEIGHT)]))
+        return whole_body.reach(side, target, move_base=False, tolerance=CARRY_TOLERANCE)
+    return None
 
 
 class _ManipulationSkill(PhasedSkill):
@@ -356,8 +376,9 @@ class Grasp(_ManipulationSkill):
         target = pin.SE3(hand.rotation.copy(), hand.translation + np.array([*(ASIDE * outwards), 0.0]))
         under = self.context.world_model.surface_under(hand.translation)
         limits = self._keep_clear(side, under) if under is not None else []
+        # as far as the arm goes that way (a wall, the end of its reach): part of the way clears part of the view
         return self.context.robot.whole_body.reach(
-            side, target, move_base=False, limits=limits, tolerance=CARRY_TOLERANCE
+            side, target, move_base=False, limits=limits, tolerance=(ASIDE, CARRY_TOLERANCE[1])
         )
 
     def _plan(self) -> None:

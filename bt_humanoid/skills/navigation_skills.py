@@ -16,7 +16,7 @@ from pydantic import Field, model_validator
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.skills.context import CheckContext, SkillContext
-from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE
+from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE, lift_what_is_held
 from bt_humanoid.skills.params import check_in_map, check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
 from bt_humanoid.skills.registry import skill
@@ -43,6 +43,9 @@ class _BaseSkill(PhasedSkill):
 
     def _tuck_arms(self) -> MotionHandle | None:
         return tuck_empty_arms(self.context)
+
+    def _lift_load(self) -> MotionHandle | None:
+        return lift_what_is_held(self.context)
 
     def _lower_torso(self) -> MotionHandle | None:
         return lower_empty_torso(self.context)
@@ -112,6 +115,7 @@ class NavigateTo(_BaseSkill):
             ("look ahead", self._look_ahead),
             ("tuck the arms", self._tuck_arms),
             ("lower the torso", self._lower_torso),
+            ("lift what is held", self._lift_load),
             ("navigate", self._navigate),
         ]
 

@@ -98,6 +98,9 @@ class Find(_ManipulationSkill):
         except KeyError as error:
             self.reason = error.args[0]
             return None
+        if target.held_by is None and target.confidence <= 0.0:  # looked for where it was, and not there: search
+            self.reason = f"I do not know where the {target.name} is now"
+            return None
         if target.held_by is None and self.context.world_model.surface_under(target.position) is None:
             self.reason = f"the {target.name} is not on any surface I know"
             return None
