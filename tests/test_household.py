@@ -163,6 +163,17 @@ def _planned_right(scene: str, say: str, expect: list[dict]) -> str | None:
         ("default", "I'm off caffeine, got anything to drink?", [{"delivered": "caffeine-free"}]),
         ("default", "get everything off the table", [{"cleared": "table"}]),
         ("tune_holding_water", "you can put that bottle down now", [{"on": ["water bottle", "any"]}]),
+        ("default", "ugh the table's a mess, could you clear it?", [{"cleared": "table"}]),
+        ("default", "thirsty af, water pls", [{"delivered": "water bottle"}]),
+        ("default", "the kids want snacks, bring two", [{"delivered": "snack", "count": 2}]),
+        ("default", "need a pick me up, something with caffeine", [{"delivered": "caffeinated"}]),
+        ("default", "could you get the coke for me", [{"delivered": "coke"}]),
+        (
+            "default",
+            "would be great if you could chuck the apple in the compost",
+            [{"inside": ["apple", "compost_bin"]}],
+        ),
+        ("default", "I could murder a packet of crisps", [{"delivered": "chips"}]),
     ],
 )
 def test_household_requests_plan_what_they_ask(scene, say, expect):

@@ -43,6 +43,9 @@ def known() -> frozenset[str]:
         ("go and stand by the trash can", ["go by the trash can"]),
         ("is there anything I can eat?", ["bring me something to eat"]),
         ("I'm off sugar, anything to drink?", ["anything to drink without sugar"]),
+        ("could I trouble you for the water bottle", ["bring me the water bottle"]),
+        ("do we have any sparkling water? I'd like one", ["with sparkling water", "bring me one"]),
+        ("hungry!! food pls", ["food"]),
     ],
 )
 def test_requests_are_read_into_plain_clauses(known, text, clauses):

@@ -140,6 +140,7 @@ class _State:
     container: str | None = None  # the bin it was last sent to ("drop it in")
     used: set[str] = field(default_factory=set)  # things a step has already claimed ("a drink" twice: two drinks)
     mentioned: str = ""  # an aside that says what is wanted ("my kid wants something sweet"): for "one"
+    mentioned_surface: str | None = None  # a surface an aside talks about ("the table's a mess"): for "clear it"
     pending: list[str] = field(default_factory=list)  # "grab every can (and bin them)": taken by the next clause
     done: dict[str, tuple[str, str]] = field(default_factory=dict)  # where this plan has already put things
     counted: bool = False  # a count or "every": the answer depends on everything there is
@@ -317,7 +318,8 @@ class EmbeddedPlanner:
             self._throw(verb, rest, state, context)
             return "throw_away"
         cleared = re.sub(r"^(?:off|up|(?:everything|all|things|stuff) (?:off|on|from))\s+", "", rest)
-        if "clear" in kinds and (not rest or _destination(cleared, context)):
+        said_before = re.fullmatch(r"(?:it|that|this)(?: up| off)?", rest) and state.mentioned_surface
+        if "clear" in kinds and (not rest or _destination(cleared, context) or said_before):
             self._clear(rest, state, context)
             return "clear"
         if "clear" in kinds:  # "tidy the chips away (onto the counter)": put it away, or back where it belongs
@@ -348,6 +350,7 @@ class EmbeddedPlanner:
             raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
         holding = re.match(r"^with\s+(?P<what>.+?)(?:\s+(?:you are|you're)\s+(?:holding|carrying))?$", clause)
         if holding is not None:
+            state.mentioned = holding["what"]  # "do we have any sparkling water? i'd like one"
             state.last = self._objects(holding["what"], state, context)
             return "aside"
         stops = [_bare(p) for p in re.split(r"\s*(?:,|\band then\b|\bthen\b|\band\b)\s*", clause) if _bare(p)]
@@ -468,6 +471,8 @@ class EmbeddedPlanner:
         """Everything believed on a surface moved off it, each to the nearest other surface with room."""
         words = re.sub(r"^(?:everything|all|the things|things|stuff)\s+(?:off|from|on)\s+", "", rest)
         words = re.sub(r"^(?:off|up)\s+", "", words)
+        if re.fullmatch(r"(?:it|that|this)(?: up| off)?", words) and state.mentioned_surface is not None:
+            words = state.mentioned_surface  # "the table is a mess, clear it"
         surface = WorldVocabulary.of(context.world).surface(_bare(words))
         if surface is None:
             refusal = NotUnderstood if not _bare(words) else PlanRefused  # a bare "tidy up" before the details
@@ -712,6 +717,10 @@ class EmbeddedPlanner:
             return list(state.last)
         if state.mentioned and re.fullmatch(r"(?:one|some|one of those|one of them|something like that)", words):
             phrase = state.mentioned  # "bring one over": one of what the aside wanted
+        count = re.fullmatch(r"(?:a couple|a few|\d+|two|three|four|five|six)(?: of them| of those)?", words)
+        if state.mentioned and count is not None:  # "the kids want snacks, bring two"
+            kind = re.sub(r"^(?:some|a|an|something|anything)\s+", "", state.mentioned)
+            phrase = f"{count.group(0).split(' of ')[0]} {kind}"
         wanted = read_wanted(phrase, _surface_words(context))
         wanted.items = [part for item in wanted.items for part in _run_together(item, context)]
         if not wanted.items:
@@ -727,6 +736,9 @@ class EmbeddedPlanner:
 
     def _mentioned(self, aside: str, state: _State, context: PlanningContext) -> None:
         """What an aside talks about becomes "it"/"them"/"one" for the clauses after it."""
+        surface = _surface_named_in(aside, context)
+        if surface is not None:
+            state.mentioned_surface = surface  # "the table's a mess, could you clear it?"
         if state.last:
             return
         wanted = read_wanted(re.sub(r"^(?:i|we|someone|my \w+)\s+\w+\s+", "", aside), _surface_words(context))
@@ -742,7 +754,9 @@ class EmbeddedPlanner:
                     state.last = alike if several else alike[:1]
                     return
         wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
-        state.mentioned = wanting.group(0) if wanting else ""  # "my kid wants something sweet": "something sweet"
+        wants = re.search(r"\b(?:wants|want|needs|need|likes|like|fancies|fancy) (?!to\b)(?P<what>.+)$", aside)
+        # "my kid wants something sweet": "something sweet"; "the kids want snacks": "snacks"
+        state.mentioned = wanting.group(0) if wanting else wants["what"] if wants else ""
 
     def _choose(self, listed: Item, wanted: Wanted, state: _State, context: PlanningContext) -> list[str]:
         """The things one listed item stands for: by name, or by what they are, seen ones first, nearest first."""
@@ -852,6 +866,18 @@ def _back(words: str, context: PlanningContext) -> str | None:
         after = words[match.start() :].strip()
         if _destination(after, context) is None:
             return (words[: match.start()] + " " + words[match.end() :]).strip()
+    return None
+
+
+def _surface_named_in(text: str, context: PlanningContext) -> str | None:
+    """A surface a sentence names, by its name or an alias ("the table's a mess" → the table)."""
+    vocabulary = WorldVocabulary.of(context.world)
+    words = text.split()
+    for length in (3, 2, 1):
+        for start in range(len(words) - length + 1):
+            surface = vocabulary.surface(" ".join(words[start : start + length]))
+            if surface is not None:
+                return surface
     return None
 
 

@@ -135,6 +135,16 @@ KIND_SYNONYMS: dict[str, str] = {
 
 # the framing around a request, left out before reading it ("could you please …", "how would you …")
 FRAMING = (
+    "it would be great if you could",
+    "would be great if you could",
+    "it would be nice if you could",
+    "would be nice if you could",
+    "it would be lovely if you could",
+    "would be lovely if you could",
+    "it would be awesome if you could",
+    "would be awesome if you could",
+    "it would help if you could",
+    "would help if you could",
     "would you be so kind as to",
     "would you be able to",
     "could you be a star and",
@@ -222,6 +232,15 @@ WANTING = (
     "get me",
     "give me",
     "i would kill for",
+    "i could murder",
+    "could murder",
+    "i could go for",
+    "i could really go for",
+    "could i trouble you for",
+    "can i trouble you for",
+    "may i trouble you for",
+    "could i bother you for",
+    "can i bother you for",
     "i am dying for",
     "i am craving",
     "i fancy",
@@ -390,4 +409,5 @@ TROUBLES = {
     "hungry": "something to eat",
     "starving": "something to eat",
     "peckish": "something to eat",
+    "throat": "something to drink",
 }

@@ -49,6 +49,11 @@ MID_FILLER = re.compile(  # words that say nothing wherever they stand
 BOTH_AND = re.compile(  # "both the coke and the pepsi", "both coke and pepsi"; not "both sparkling waters and …"
     r"\bboth\s+(?=the\s+[a-z0-9 -]+?\s+and\s+|[a-z0-9 -]*?[a-z0-9-]*[^s\s]\s+and\s+)"
 )
+IS_CONTRACTED = re.compile(
+    r"(?<=[a-z])'s\s+(?=(?:a|an|so|really|all|gone|not|empty|full|dirty|sticky|messy|covered|filthy|over|still|"
+    r"been|getting|too|very|quite|pretty|such|soft|bad|off|finished|done)\b)",
+    re.IGNORECASE,
+)
 HOW_WOULD_YOU = re.compile(r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b", re.IGNORECASE)
 SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>|-+)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
 STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\d+[.)]?|[a-z][.)])\s+")
@@ -70,6 +75,7 @@ def read(text: str, known: frozenset[str]) -> list[str]:
     text = text.replace("’", "'").replace("->", " -> ").replace("→", " -> ")
     text = HOW_WOULD_YOU.sub(" ", text)  # "how would you …" asks for the plan: the planner explains and does it
     text = re.sub(r"\b(?:yourself|urself|itself)\b", " ", text, flags=re.IGNORECASE)
+    text = IS_CONTRACTED.sub(" is ", text)  # "the table's a mess": "is", not whose
     clauses = []
     for sentence in SENTENCE_BREAK.split(" " + text.lower() + " "):
         sentence = STEP_NUMBER.sub("", sentence.strip())
@@ -90,13 +96,20 @@ def read(text: str, known: frozenset[str]) -> list[str]:
                 continue
             if pieces and ANY_WILL_DO.match(piece) and re.search(r"\b(?:a|an|some|something|anything)\b", pieces[-1]):
                 continue  # "get me a drink, any drink": any one will do
+            refined = REFINED.match(piece)
+            if pieces and refined and pieces[-1].startswith("bring me ") and not starts_clause(piece):
+                pieces[-1] = f"bring me {refined['what']}"  # "need a pick me up, something with caffeine"
+                continue
+            if pieces and pieces[-1] in NEED_REQUESTS and not starts_clause(piece) and not is_context(piece):
+                pieces[-1] = f"bring me {piece}"  # "thirsty af, water pls": the water is what meets it
+                continue
             if pieces and not starts_clause(piece) and not is_context(piece) and not is_context(pieces[-1]):
                 pieces[-1] += " , " + piece
             else:
                 pieces.append(piece)
         clauses += [clause for piece in _in_order(pieces) for clause in split_clauses(piece)]
     clauses = [unframe(clause) for clause in clauses if unframe(clause)]
-    clauses = _avoiding(_topic_first(_in_order(clauses)))
+    clauses = _avoiding(_topic_first(_in_order(_asked_if_there(clauses))))
     if clauses and all(is_context(c) for c in clauses):  # "my desk is sticky, help": the trouble says what
         trouble = next((TROUBLES[w] for c in clauses for w in c.split() if w in TROUBLES), None)
         if trouble is not None:
@@ -165,6 +178,17 @@ OFF = re.compile(  # "i'm off sugar this month": what is asked for next must be 
     r"not (?:having|drinking|eating))\s+(?P<what>.+?)(?:\s+(?:this|for|at|right|these)\b.*)?$"
 )
 OPEN_REQUEST = re.compile(r"\b(?:something|anything|a drink|a snack|some\s+\w+)\b")
+
+
+def _asked_if_there(clauses: list[str]) -> list[str]:
+    """ "do we have any sparkling water? i'd like one": the question names what the next clause asks for."""
+    out = list(clauses)
+    for i, clause in enumerate(clauses[:-1]):
+        there = HAVE_ANY.match(clause)
+        asked_next = starts_clause(clauses[i + 1]) or WANT_AT_START.match(clauses[i + 1])
+        if there is not None and asked_next:
+            out[i] = f"with {there['what'] or there['other'] or there['third']}"
+    return out
 
 
 def _avoiding(clauses: list[str]) -> list[str]:
@@ -262,6 +286,12 @@ ANYTHING_TO = re.compile(
     r"^(?:is there|have you got|have we got|do you have|do we have|got)\s+(?:anything|something)\s+"
     r"(?:(?:that\s+)?(?:i|we)\s+(?:can|could)\s+|to\s+)(?P<verb>drink|eat|snack on|have)\b"
 )
+REFINED = re.compile(r"^(?:preferably|ideally|maybe|like|say)?\s*(?P<what>something\b(?!.*\b(?:but|except)\b).*)$")
+FOR_ME = re.compile(r"^(?:get|grab|fetch|snag|nab|pick up|go get)\s+(?P<what>.+?)\s+for (?:me|us)(?:\s+please)?$")
+HAVE_ANY = re.compile(
+    r"^(?:do|have) (?:we|you) (?:have|got) (?:any|some) (?P<what>.+)$|^(?:is|are) there (?:any|some) (?P<other>.+?)"
+    r"(?: left| around| here)?$|^(?:(?:you |we )?got )?any (?P<third>.+?)(?: left| around)?$"
+)
 PARTICIPLES = {
     **dict.fromkeys(("moved", "put", "placed", "taken", "carried", "brought", "set", "left"), "put"),
     **dict.fromkeys(("thrown", "binned", "tossed", "chucked", "dumped"), "throw"),
@@ -274,11 +304,19 @@ NEED = re.compile(
     + "|".join(NEEDS)
     + r")\b"
 )
+BARE_NEED = re.compile(  # "thirsty af", "so hungry!!": the need alone, said without "i am"
+    r"^(?:so\s+|really\s+|absolutely\s+|kinda\s+|super\s+)*(?P<need>"
+    + "|".join(NEEDS)
+    + r")(?:\s+(?:af|rn|now|right now|lol|too|as hell|here|over here|today))*$"
+)
 
 
 def unframe(clause: str) -> str:
     """A clause without the words around what it asks ("could you please …", "… for me"); a want or a need as a
     request to bring something."""
+    for_me = FOR_ME.match(clause)
+    if for_me is not None:  # "could you get the coke for me": get it to me
+        clause = f"bring me {for_me['what']}"
     previous = None
     while clause != previous:
         previous = clause
@@ -300,7 +338,7 @@ def unframe(clause: str) -> str:
     would = WOULD_BE.match(clause)
     if would is not None:
         return f"bring me {would['what']}"
-    need = NEED.match(clause)
+    need = NEED.match(clause) or BARE_NEED.match(clause)
     if need is not None:
         return f"bring me {NEEDS[need['need']]}"
     wanted = WANT_AT_START.match(clause)
