@@ -138,6 +138,9 @@ def _free_spot(
     return None
 
 
+ROLLING_RESISTANCE = 0.003  # m: a round thing's rolling friction (an apple's lumps and flattened bottom)
+
+
 def add_objects(spec: mujoco.MjSpec, world: WorldConfig, objects: list[PlacedObject]) -> None:
     """Add each placed object as a free body, with its model's textured material."""
     materials: dict[str, str] = {}
@@ -159,6 +162,10 @@ def add_objects(spec: mujoco.MjSpec, world: WorldConfig, objects: list[PlacedObj
             solref=[0.004, 1.0],
             material=materials[placed.object],
         )
+        if model.shape == "sphere":
+            # a fruit is lumpy, not a ball: its shape resists rolling (rolling friction, metres of lever arm);
+            # a perfect sphere set down with a millimetre a second of speed rolls on off the table's edge
+            geom.update(condim=6, friction=[model.friction, 0.01, ROLLING_RESISTANCE])
         half = np.array(model.size) / 2
         if model.shape == "cylinder":
             shape, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [half[0], half[2], 0.0]
