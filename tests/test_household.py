@@ -174,6 +174,16 @@ def _planned_right(scene: str, say: str, expect: list[dict]) -> str | None:
             [{"inside": ["apple", "compost_bin"]}],
         ),
         ("default", "I could murder a packet of crisps", [{"delivered": "chips"}]),
+        (
+            "default",
+            "put the pepsi in the recycling and then the coke too",
+            [{"inside": [["pepsi", "coke"], "recycling_bin"], "count": 2}],
+        ),
+        (
+            "default",
+            "start by taking the apple to the compost, then bring me the tea",
+            [{"inside": ["apple", "compost_bin"]}, {"delivered": "tea"}],
+        ),
     ],
 )
 def test_household_requests_plan_what_they_ask(scene, say, expect):

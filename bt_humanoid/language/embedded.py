@@ -167,7 +167,7 @@ class EmbeddedPlanner:
         clauses = read(text, known_words(context))
         if replace is not None:
             clauses = [_replace_phrase(clause, *replace) for clause in clauses]
-        clauses = _fetched_to_put(clauses)
+        clauses = _same_again(_fetched_to_put(clauses), context)
         if not clauses:
             return Plan("refusal", "I did not hear a command.")
         state = _State.at_start(context)
@@ -879,6 +879,28 @@ def _surface_named_in(text: str, context: PlanningContext) -> str | None:
             if surface is not None:
                 return surface
     return None
+
+
+SAME_AGAIN = re.compile(
+    r"(?:and |then |and then )*(?:also |do )?(?P<np>.+?) (?:too|as well)|"
+    r"(?:and |then |and then )*(?:also|likewise|same for|same with|same goes for|and also) (?P<also>.+)"
+)
+
+
+def _same_again(clauses: list[str], context: PlanningContext) -> list[str]:
+    """ "put the pepsi in the recycling, then the coke too": the last verb and destination, for another thing."""
+    out: list[str] = []
+    for clause in clauses:
+        again = SAME_AGAIN.fullmatch(clause)
+        verb, rest = _verb_of(out[-1]) if out else (None, "")
+        if again is not None and verb is not None and _verb_of(clause)[0] is None:
+            thing = again["np"] or again["also"]
+            what, where = _split_destination(rest, context, moving=True)
+            destination = rest[len(what) :].strip() if where is not None and rest.startswith(what) else ""
+            out.append(f"{verb} {thing} {destination}".strip())
+        else:
+            out.append(clause)
+    return out
 
 
 def _fetched_to_put(clauses: list[str]) -> list[str]:

@@ -255,6 +255,10 @@ WANTING = (
 )
 # words that start a clause but say nothing to do
 FILLERS = (
+    "start by",
+    "begin by",
+    "to start",
+    "to begin with",
     "hey",
     "hi",
     "hello",

@@ -90,7 +90,8 @@ def read(text: str, known: frozenset[str]) -> list[str]:
         plain = re.sub(r"(?<=\w )what(?:ever)?(?: is| there is)?(?= (?:on|in|at|from|off)\b)", "everything", plain)
         pieces: list[str] = []
         # a comma ends a clause before a verb or an aside only; "X goes to A and Y to B" is two
-        for piece in (part for chunk in re.split(r"\s*,\s*", plain) for part in BELONGS_BREAK.split(chunk)):
+        chunks = [part for chunk in re.split(r"\s*,\s*", plain) for part in BELONGS_BREAK.split(chunk)]
+        for piece in (part for chunk in chunks for part in TOO_BREAK.split(chunk)):
             piece = unframe(piece)
             if not piece:
                 continue
@@ -103,7 +104,9 @@ def read(text: str, known: frozenset[str]) -> list[str]:
             if pieces and pieces[-1] in NEED_REQUESTS and not starts_clause(piece) and not is_context(piece):
                 pieces[-1] = f"bring me {piece}"  # "thirsty af, water pls": the water is what meets it
                 continue
-            if pieces and not starts_clause(piece) and not is_context(piece) and not is_context(pieces[-1]):
+            again = re.search(r"\b(?:too|as well)$", piece)  # "…, then the coke too": the same again, apart
+            joins = not again and not starts_clause(piece) and not is_context(piece)
+            if pieces and joins and not is_context(pieces[-1]):
                 pieces[-1] += " , " + piece
             else:
                 pieces.append(piece)
@@ -280,6 +283,7 @@ BELONGS_BREAK = re.compile(
     r"\s+(?:and|,)\s+(?=[a-z0-9 -]+?\s+(?:needs? to |has to |should |must )?(?:go|goes|belongs?)\s+"
     r"(?:back\s+)?(?:on|in|into|onto|to|inside)\b)"
 )
+TOO_BREAK = re.compile(r"\s+(?:and then|then|and)\s+(?=(?:also\s+)?(?:the |a |an )?[a-z0-9 -]+? (?:too|as well)$)")
 COME_TO_ME = re.compile(r"^(?:come|go)(?: and)? (?:find|see|join|get) (?:me|us)$|^find me$")
 GO_AND_STAY = re.compile(r"^(?P<go>go|come|head)(?: and| over and| over)? (?:stand|wait|park|stay|sit|hang out|be)\b")
 ANYTHING_TO = re.compile(
