@@ -28,7 +28,7 @@ from bt_humanoid.control.stance import StanceError, stance_for
 from bt_humanoid.control.wbc.limits import BaseBoundsLimit, BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.free_space import EDGE_MARGIN, MAX_SHIFT, nearest_free
-from bt_humanoid.perception.world_model import SupportSurface
+from bt_humanoid.perception.world_model import SupportSurface, TrackedObject, WorldModel
 from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.params import check_in_map, check_name, check_object
 from bt_humanoid.skills.phased import PhasedSkill, PhaseFailure
@@ -52,18 +52,23 @@ BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its lin
 ASIDE = 0.18  # m a hand in the camera's way moves outwards: out of a 20° cone at the arm's usual reach
 
 
+def carry_height(belief: WorldModel, held: TrackedObject | None) -> float:
+    """How high a hand carries ``held`` (or nothing): what hangs below it clears every known surface's top."""
+    below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
+    highest = max((s.height for s in belief.surfaces.values()), default=0.0)
+    return max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE)
+
+
 def lift_what_is_held(context: SkillContext) -> MotionHandle | None:
     """Raise a hand whose load hangs lower than the furniture's tops plus a clearance (as a scene may start a
     tall bottle held low), before the base drives past the furniture; nothing when every load is clear."""
     belief = context.world_model
-    highest = max((s.height for s in belief.surfaces.values()), default=0.0)
     whole_body = context.robot.whole_body
     for side in context.robot_config.grippers:
         held = belief.held(side)
         if held is None:
             continue
-        below_hand = held.grip_offset + float(held.size[2]) / 2
-        needed = max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE)
+        needed = carry_height(belief, held)
         hand = whole_body.frame_pose(whole_body.hand_frame(side))
         if hand.translation[2] >= needed - 0.02:
             continue
@@ -161,13 +166,10 @@ class _ManipulationSkill(PhasedSkill):
         xy = self._carry_xy(side)
         # high enough that what hangs below the hand clears every known surface on the way
         held = self.context.world_model.held(side)
-        below_hand = held.grip_offset + float(held.size[2]) / 2 if held is not None else 0.0
-        n_given = len(clearances)
+        height = max(carry_height(self.context.world_model, held), *(c.height for c in clearances))
         under = self.context.world_model.surface_under(self._hand_xyz(side))
-        if under is not None:
+        if under is not None:  # held up over the things it passes, not carried at their height
             clearances = [*clearances, *self._keep_clear(side, under)]
-        highest = max((s.height for s in self.context.world_model.surfaces.values()), default=0.0)
-        height = max(CARRY_HEIGHT, highest + below_hand + APPROACH_CLEARANCE, *(c.height for c in clearances[:n_given]))
         # an empty hand turns to its natural yaw; a full one keeps its yaw (as grasped) so nothing swings
         hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(yaw)
         target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, min(height, MAX_CARRY_HEIGHT)]))
