@@ -43,21 +43,16 @@ def things_on(world_model: WorldModel, surface: SupportSurface, exclude: Iterabl
     ]
 
 
-def footprint_radius(thing: TrackedObject) -> float:
-    """The radius of the circle round ``thing``'s extents in the plane."""
-    return float(np.hypot(thing.size[0], thing.size[1])) / 2
-
-
 def hand_radius(held: TrackedObject | None, is_open: bool) -> float:
     """How far across the hand reaches from its grip site: spread pads, the palm, or what it holds."""
     if held is not None:
-        return max(footprint_radius(held), CLOSED_HAND_RADIUS)
+        return max(held.footprint_radius, CLOSED_HAND_RADIUS)
     return OPEN_HAND_RADIUS if is_open else CLOSED_HAND_RADIUS
 
 
 def reach_radius(thing: TrackedObject, hand: float = OPEN_HAND_RADIUS) -> float:
     """How near the grip site may come to ``thing``'s centre, across, before a hand ``hand`` wide touches it."""
-    return footprint_radius(thing) + hand
+    return thing.footprint_radius + hand
 
 
 def clear_height(thing: TrackedObject, below_hand: float, margin: float = THING_MARGIN) -> float:

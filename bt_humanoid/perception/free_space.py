@@ -55,7 +55,7 @@ def nearest_free(
     """``spot`` if a thing ``radius`` round fits there clear of what is believed on ``surface``; else the nearest
     spot within ``MAX_SHIFT`` that does, on the surface; None if there is none."""
     others = [
-        (o.position[:2], float(np.hypot(o.size[0], o.size[1])) / 2)
+        (o.position[:2], o.footprint_radius)
         for o in belief.present()
         if o.held_by is None and o.id not in exclude and surface.contains(o.position[:2])
     ]

@@ -46,6 +46,11 @@ class TrackedObject:
     def top(self) -> float:
         return float(self.position[2] + self.size[2] / 2)
 
+    @property
+    def footprint_radius(self) -> float:
+        """The radius of the circle round its extents in the plane (m)."""
+        return float(np.hypot(self.size[0], self.size[1])) / 2
+
 
 @dataclass
 class SupportSurface:

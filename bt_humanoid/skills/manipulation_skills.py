@@ -17,7 +17,6 @@ from pydantic import Field, model_validator
 from bt_humanoid.control.grasping import LIFT_HEIGHT, PAD_HALF_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
 from bt_humanoid.control.keep_clear import (
     clearance_limits,
-    footprint_radius,
     hand_radius,
     over_limit,
     things_on,
@@ -534,7 +533,7 @@ class Put(_ManipulationSkill):
         if not self.surface.contains(spot, margin=EDGE_MARGIN):
             raise PhaseFailure(f"spot ({spot[0]:.2f}, {spot[1]:.2f}) is not on the {self.surface.name}")
         # a spot something already stands on (as believed) moves aside to the nearest free one
-        free = nearest_free(self.surface, self.context.world_model, spot, footprint_radius(self.held), (self.held.id,))
+        free = nearest_free(self.surface, self.context.world_model, spot, self.held.footprint_radius, (self.held.id,))
         if free is None:
             raise PhaseFailure(
                 f"spot ({spot[0]:.2f}, {spot[1]:.2f}) on the {self.surface.name} is taken, and nothing within "
