@@ -48,7 +48,21 @@ def robot_spec(config: RobotConfig) -> mujoco.MjSpec:
     with _quiet_empty_prefix_warning():
         lower.attach(upper, site=config.parts.mount_site, prefix="")
     lower.modelname = config.name
+    if config.base.floating:
+        _no_body_gravcomp(lower)
     return lower
+
+
+def _no_body_gravcomp(spec: mujoco.MjSpec) -> None:
+    """Switch off MuJoCo's body gravity compensation on a robot with a floating base.
+
+    ``gravcomp`` pushes each body up with its own weight; ``actuatorgravcomp`` routes a joint's share of that
+    through its actuator, but a free joint has no actuator and no force limit, so its share, the whole weight of
+    every compensated body, would hold the robot up from outside. On a floating base the motors must carry the
+    weight (the controller's gravity torques), as real ones do.
+    """
+    for body in spec.bodies:
+        body.gravcomp = 0.0
 
 
 def world_spec(world: WorldConfig, robot: RobotConfig, objects: list[PlacedObject] | None = None) -> mujoco.MjSpec:

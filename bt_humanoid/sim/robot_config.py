@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from bt_humanoid.paths import robots_dir
 from bt_humanoid.strict_model import StrictModel
@@ -31,12 +32,46 @@ class BaseTolerance(StrictModel):
     yaw_deg: float = 2.0
 
 
+PLANAR_AXES = ("x", "y", "yaw")
+
+
 class BaseConfig(StrictModel):
-    joints: dict[str, str]
-    actuators: dict[str, str]
+    """How the robot's base moves: planar joints driven by actuators (a wheeled base), or a floating base (a free
+    joint nothing drives: the legs carry it)."""
+
+    kind: Literal["planar", "floating"] = "planar"
+    joints: dict[str, str] = Field(description="planar: {x, y, yaw: joint}; floating: {free: the free joint}")
+    actuators: dict[str, str] = Field(description="planar: {x, y, yaw: actuator}; floating: none ({})")
     footprint_radius: float = 0.3
     limits: BaseLimits = BaseLimits()
     tolerance: BaseTolerance = BaseTolerance()
+
+    @model_validator(mode="after")
+    def _joints_fit_the_kind(self) -> BaseConfig:
+        if self.kind == "planar":
+            for key in ("joints", "actuators"):
+                if set(getattr(self, key)) != set(PLANAR_AXES):
+                    raise ValueError(f"a planar base names {key} for x, y and yaw, not {sorted(getattr(self, key))}")
+        else:
+            if set(self.joints) != {"free"}:
+                raise ValueError(f"a floating base names one free joint ({{free: NAME}}), not {sorted(self.joints)}")
+            if self.actuators:
+                raise ValueError("a floating base has no actuators (actuators: {}): the legs move it")
+        return self
+
+    @property
+    def floating(self) -> bool:
+        return self.kind == "floating"
+
+    @property
+    def planar_joints(self) -> list[str]:
+        """The x, y and yaw joints of a planar base, in that order; none for a floating base."""
+        return [self.joints[axis] for axis in PLANAR_AXES] if self.kind == "planar" else []
+
+    @property
+    def root_joint(self) -> str:
+        """The joint nearest the world: the robot's bodies are the tree it moves."""
+        return self.joints["free"] if self.floating else self.joints["x"]
 
 
 class GripperConfig(StrictModel):
@@ -65,6 +100,89 @@ class ScannerConfig(StrictModel):
     rays: int = Field(180, ge=8, le=2000, description="rays over the full circle")
     range: float = Field(4.0, gt=0, description="m beyond which nothing is seen")
     rate_hz: float = Field(50.0, gt=0, description="scans per second")
+
+
+LEG_ROLES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
+
+
+class LegConfig(StrictModel):
+    """One leg: its joints from the hip down, its foot and the sensors on it (MJCF names)."""
+
+    joints: list[str] = Field(description="hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle roll: in that order")
+    foot: str = Field(description="the foot's body")
+    sole: str = Field(description="site at the centre of the sole's contact rectangle, on the sole plane, x forward")
+    force_sensor: str = Field(description="3-axis force the ankle exerts on the foot, in the sensor site's frame")
+    torque_sensor: str = Field(description="3-axis torque the ankle exerts on the foot, in the sensor site's frame")
+    touch_sensor: str = Field(description="normal force of the ground on the sole")
+
+    @model_validator(mode="after")
+    def _six_joints(self) -> LegConfig:
+        if len(self.joints) != len(LEG_ROLES):
+            raise ValueError(f"a leg has {len(LEG_ROLES)} joints ({', '.join(LEG_ROLES)}), not {len(self.joints)}")
+        return self
+
+
+class SoleConfig(StrictModel):
+    """The rectangle each foot stands on, centred on its sole site: where its contacts are."""
+
+    length: float = Field(gt=0, description="m along the foot (x)")
+    width: float = Field(gt=0, description="m across the foot (y)")
+    friction: float = Field(0.7, gt=0, description="friction coefficient a controller may count on (below the floor's)")
+
+
+class StanceConfig(StrictModel):
+    """The neutral standing posture (bt_humanoid.sim.standing): feet flat and parallel, knees slightly bent."""
+
+    pelvis_height: float = Field(gt=0, description="m from the floor to the pelvis origin")
+    width: float = Field(gt=0, description="m between the sole centres")
+
+
+class LegsConfig(StrictModel):
+    """Two torque-controlled legs under a floating base: what a walking controller needs beyond the MJCF."""
+
+    left: LegConfig
+    right: LegConfig
+    sole: SoleConfig
+    stance: StanceConfig
+    torque_limits: dict[str, float] = Field(description="N·m per joint role (the motors' ctrlrange in the MJCF)")
+    speed_limits: dict[str, float] = Field(description="rad/s per joint role: the motors' no-load speed")
+
+    @model_validator(mode="after")
+    def _every_role(self) -> LegsConfig:
+        for key in ("torque_limits", "speed_limits"):
+            given = getattr(self, key)
+            if set(given) != set(LEG_ROLES):
+                raise ValueError(f"{key}: one value for each of {', '.join(LEG_ROLES)}; got {', '.join(given)}")
+            if any(value <= 0 for value in given.values()):
+                raise ValueError(f"{key}: limits are positive")
+        return self
+
+    @property
+    def joints(self) -> list[str]:
+        """Every leg joint: the left leg's from the hip down, then the right's."""
+        return self.left.joints + self.right.joints
+
+    def role(self, joint: str) -> str:
+        """hip_yaw, …, ankle_roll: which joint of its leg ``joint`` is."""
+        for leg in (self.left, self.right):
+            if joint in leg.joints:
+                return LEG_ROLES[leg.joints.index(joint)]
+        raise KeyError(f"{joint!r} is not a leg joint")
+
+    def torque_limit(self, joint: str) -> float:
+        return self.torque_limits[self.role(joint)]
+
+    def speed_limit(self, joint: str) -> float:
+        return self.speed_limits[self.role(joint)]
+
+
+class ImuConfig(StrictModel):
+    """An inertial measurement unit: its site and sensors (MJCF names)."""
+
+    site: str
+    gyro: str = Field(description="angular velocity, rad/s, in the site's frame")
+    accelerometer: str = Field(description="specific force, m/s², in the site's frame (+g upwards at rest)")
+    orientation: str | None = Field(None, description="the site's attitude (w, x, y, z), as a filter would give")
 
 
 class MotionLimits(StrictModel):
@@ -103,9 +221,23 @@ class RobotConfig(StrictModel):
     scanner: ScannerConfig | None = None
     joint_limits: dict[str, MotionLimits]
     postures: dict[str, dict[str, float]]
+    legs: LegsConfig | None = Field(None, description="torque-controlled legs under a floating base")
+    imu: ImuConfig | None = None
     safety: SafetyDefaults = SafetyDefaults()
     recovery: RecoveryDefaults = RecoveryDefaults()
     folder: Path = Path()
+
+    @model_validator(mode="after")
+    def _legs_carry_a_floating_base(self) -> RobotConfig:
+        if self.base.floating and self.legs is None:
+            raise ValueError("a floating base needs legs: (nothing else carries it)")
+        if self.legs is not None and not self.base.floating:
+            raise ValueError("legs: go with a floating base (base: kind: floating)")
+        if self.legs is not None:
+            grouped = {joint for joints in self.groups.values() for joint in joints}
+            if both := grouped & set(self.legs.joints):
+                raise ValueError(f"leg joints are torque-controlled, not in groups: {', '.join(sorted(both))}")
+        return self
 
     def motion_limits(self, joint: str) -> MotionLimits:
         """Velocity/acceleration/jerk limits of one joint: its own, its group's, or the default."""

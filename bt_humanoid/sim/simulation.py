@@ -21,6 +21,7 @@ from bt_humanoid.sim.holding import CARRY_POSTURE, SQUEEZE, Hold, hold_for
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig, load_scene, start_pose
 from bt_humanoid.sim.scene_objects import PlacedObject, SceneError, place_scene, surface_tops
+from bt_humanoid.sim.standing import Stance, standing_posture
 from bt_humanoid.sim.walkers import WalkerDriver
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 
@@ -53,13 +54,15 @@ class Simulation:
         self.model = self.spec.compile()
         self.data = mujoco.MjData(self.model)
         self.timestep = float(self.model.opt.timestep)
-        root = int(self.model.body_rootid[self.model.joint(robot.base.joints["x"]).bodyid[0]])
+        root = int(self.model.body_rootid[self.model.joint(robot.base.root_joint).bodyid[0]])
         #: every body of the robot: the tree under the body its base joints move
         self.robot_bodies = {b for b in range(self.model.nbody) if self.model.body_rootid[b] == root}
         self.walkers = [
             WalkerDriver(self.model, self.data, name, walker, root, self.robot_bodies)
             for name, walker in world.walkers.items()
         ]
+        #: a legged robot starts standing: its neutral stance, placed at the start pose
+        self.stance: Stance | None = standing_posture(robot) if robot.legs is not None else None
         self.reset()
 
     @classmethod
@@ -76,10 +79,16 @@ class Simulation:
         """Initial state: robot at the world's start pose in its home posture, actuators holding it."""
         mujoco.mj_resetData(self.model, self.data)
         x, y, yaw_deg = start_pose(self.scene, self.world)
-        base = self.robot.base.joints
-        self.set_initial_joint(base["x"], x)
-        self.set_initial_joint(base["y"], y)
-        self.set_initial_joint(base["yaw"], math.radians(yaw_deg))
+        if self.stance is not None:  # feet flat on the floor, centred on the start; the motors start off
+            free = self.model.joint(self.robot.base.root_joint).qposadr[0]
+            self.data.qpos[free : free + 7] = self.stance.base_pose(x, y, math.radians(yaw_deg))
+            for joint, value in self.stance.joints.items():
+                self.set_initial_joint(joint, value)
+        else:
+            base = self.robot.base.joints
+            self.set_initial_joint(base["x"], x)
+            self.set_initial_joint(base["y"], y)
+            self.set_initial_joint(base["yaw"], math.radians(yaw_deg))
         for joint, value in self.robot.postures.get("home", {}).items():
             self.set_initial_joint(joint, value)
         if self.held is not None:

@@ -21,8 +21,12 @@ from bt_humanoid.sim.robot_config import RobotConfig
 _models: dict[Path, pin.Model] = {}
 
 
-def _model_for(config: RobotConfig) -> pin.Model:
-    """Pinocchio model of a robot, built once per process (a few tens of ms)."""
+def robot_model(config: RobotConfig) -> pin.Model:
+    """Pinocchio model of a robot, built once per process (a few tens of ms).
+
+    A planar base's x, y and yaw joints become one composite joint; a floating base's MJCF free joint becomes a
+    free-flyer (configuration x, y, z, then the quaternion as x, y, z, w where MuJoCo writes w, x, y, z).
+    """
     if config.folder in _models:
         return _models[config.folder]
     with tempfile.TemporaryDirectory() as folder:
@@ -51,12 +55,12 @@ class RobotKinematics:
     """Forward kinematics and frame Jacobians over the controlled joints."""
 
     def __init__(self, config: RobotConfig, joints: list[str]) -> None:
-        self.model = _model_for(config)
+        self.model = robot_model(config)
         self.data = self.model.createData()
         self.joints = list(joints)
         self.q = pin.neutral(self.model)
         self.positions = np.zeros(len(self.joints))  # controlled joints, as last set by update()
-        base = [config.base.joints[axis] for axis in ("x", "y", "yaw")]
+        base = config.base.planar_joints  # a floating base stays where update() leaves it: not controlled here
         q_index, v_index = [], []
         for joint in self.joints:
             if joint in base:
