@@ -113,6 +113,11 @@ HELD_PHRASE = re.compile(
     r"^(?:(?:the )?(?:thing|one|object|stuff)? ?(?:in|from) your hand|(?:the )?(?:thing |one )?(?:that )?"
     r"(?:what )?you (?:are )?(?:holding|carrying|have)|what you have|what is in your hand)$"
 )
+POINTED_AT = re.compile(r"^(it|them|that|this|those|these)\s+(?:off|from|out of|on|in)\s+.+$")
+ONE_OF_THOSE = re.compile(  # "bring one over (without cola)": one of what an aside wanted
+    r"(?:one|some|one of those|one of them|something like that)(?:\s+(?:over|here|over here|back))?"
+    r"(?P<but>\s+(?:without|but not)\s.+)?"
+)
 BRING_ONLY = {"bring", "fetch", "deliver", "hand", "give", "pass", "send", "toss"}
 
 
@@ -144,6 +149,8 @@ class _State:
     pending: list[str] = field(default_factory=list)  # "grab every can (and bin them)": taken by the next clause
     done: dict[str, tuple[str, str]] = field(default_factory=dict)  # where this plan has already put things
     counted: bool = False  # a count or "every": the answer depends on everything there is
+    clear_later: list[str] = field(default_factory=list)  # "clear the table: the cans to the recycling, …"
+    more_to_come: bool = False  # clauses follow the one being planned
 
     @classmethod
     def at_start(cls, context: PlanningContext) -> _State:
@@ -173,7 +180,8 @@ class EmbeddedPlanner:
         state = _State.at_start(context)
         asides: list[NotUnderstood] = []
         try:
-            for clause in clauses:
+            for i, clause in enumerate(clauses):
+                state.more_to_come = i < len(clauses) - 1
                 try:
                     kind = self._clause(clause, state, context)
                 except NotUnderstood as aside:
@@ -184,6 +192,9 @@ class EmbeddedPlanner:
                     return Plan("stop", "Stopping.")
             if len(asides) == len(clauses):
                 raise asides[0]
+            state.more_to_come = False
+            for rest in state.clear_later:  # what the details after "clear the table" left there
+                self._clear(rest, state, context)
             if state.pending:
                 raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(state.pending)}.")
         except Question as question:
@@ -406,9 +417,10 @@ class EmbeddedPlanner:
             surface = self._surface_of(beside["other"], state, context)
             if surface is not None:
                 what, where = what[: beside.start()].strip(), ("surface", surface)
-        if where is None and re.search(r"\s+there$", what):  # "leave them there": where the last went
-            what = re.sub(r"\s+there$", "", what)
-            where = ("surface", state.surface) if state.surface else None
+        if where is None and re.search(r"\s+there$", what):  # "leave them there": where the last went, or the
+            what = re.sub(r"\s+(?:over\s+)?there$", "", what)  # surface an aside spoke of ("the table is sticky")
+            there = state.surface or state.mentioned_surface
+            where = ("surface", there) if there else None
         if not what:
             what = "it"
         if where is not None and where[0] == "person":
@@ -478,7 +490,19 @@ class EmbeddedPlanner:
             refusal = NotUnderstood if not _bare(words) else PlanRefused  # a bare "tidy up" before the details
             raise refusal(f"I can clear a surface: the {_surfaces(context)}.")
         state.counted = True  # everything on it: what was seen from afar may not be all
-        on_it = [o for o in context.belief.present() if o.held_by is None and _on_surface(o, surface, context)]
+        state.mentioned_surface = surface  # "clear the table: the chips in the bin": the chips on the table
+        if state.more_to_come and rest not in state.clear_later:
+            state.clear_later.append(rest)  # the clauses after it may say where things go: they go first
+            state.lines.append(f"clear the {_spoken(surface)}")
+            return
+        moved = set(state.done) | state.used
+        on_it = [
+            o
+            for o in context.belief.present()
+            if o.held_by is None
+            and _on_surface(o, surface, context)
+            and not {_name_of(o, context), _one_of(o, context)} & moved
+        ]
         if not on_it:
             state.lines.append(f"find the {_spoken(surface)} already clear")
             return
@@ -617,6 +641,11 @@ class EmbeddedPlanner:
     def _put_on_surface(self, target: str, surface_name: str, state: _State, context: PlanningContext) -> None:
         if state.done.get(target) == ("on", surface_name):  # "take it to the table and leave it there": once
             return
+        there = _tracked(target, context)
+        if target not in state.done and state.held != target and there and _on_surface(there, surface_name, context):
+            state.lines.append(f"leave the {target} on the {_spoken(surface_name)}, where it is")  # "make sure …"
+            state.last = [target]
+            return
         surface = context.belief.surface(surface_name)
         place = context.world.surfaces[surface_name].place
         approach = np.array(context.world.places[place].pose[:2])
@@ -699,6 +728,7 @@ class EmbeddedPlanner:
     def _objects(self, phrase: str, state: _State, context: PlanningContext) -> list[str]:
         """The objects a phrase names: one, several listed, a count of a kind, or every one of a kind."""
         words = _bare(phrase.strip().strip(" ,"))
+        words = POINTED_AT.sub(r"\1", words)  # "it off the table": "it" says which, the rest where it is
         if HELD_PHRASE.match(words):
             if state.held is None:
                 raise PlanRefused("I am not holding anything.")
@@ -715,8 +745,9 @@ class EmbeddedPlanner:
             if not state.last:
                 raise PlanRefused("I don't know what 'them' are; name the objects.")
             return list(state.last)
-        if state.mentioned and re.fullmatch(r"(?:one|some|one of those|one of them|something like that)", words):
-            phrase = state.mentioned  # "bring one over": one of what the aside wanted
+        one = ONE_OF_THOSE.fullmatch(words)
+        if state.mentioned and one is not None:
+            phrase = state.mentioned + (one["but"] or "")  # "bring one over": one of what the aside wanted
         count = re.fullmatch(r"(?:a couple|a few|\d+|two|three|four|five|six)(?: of them| of those)?", words)
         if state.mentioned and count is not None:  # "the kids want snacks, bring two"
             kind = re.sub(r"^(?:some|a|an|something|anything)\s+", "", state.mentioned)
@@ -763,8 +794,14 @@ class EmbeddedPlanner:
         item = listed.words
         if item in ("it", "that", "this", "them", "those"):
             return self._objects(item, state, context)
-        name = _world_name_in(item, context)
-        kinds = [name] if name is not None else _candidates(item, context)
+        if listed.alternatives:  # "the pepsi or the coke": whichever of them is nearest
+            kinds = list(dict.fromkeys(k for option in listed.alternatives for k in _kinds_named(option, context)))
+            if not kinds:
+                raise PlanRefused(_not_seen(listed.alternatives[0], context))
+            name = None
+        else:
+            name = _world_name_in(item, context)
+            kinds = [name] if name is not None else _candidates(item, context)
         if not kinds and not is_open(item):
             if listed.count or listed.every:
                 raise PlanRefused(f"I don't see any {item}.")
@@ -800,6 +837,10 @@ class EmbeddedPlanner:
                 )
             return pool
         if listed.definite and not listed.count and name is None and _plural_of_a_kind(item, context):
+            spoken_of = state.mentioned_surface
+            there = [p for p, o in zip(pool, seen, strict=False) if spoken_of and _on_surface(o, spoken_of, context)]
+            if there and wanted.source is None:  # "clear the table: recycle the cans": the cans on it
+                return there
             return pool if pool else self._choose(Item(item, every=True), wanted, state, context)  # "the bottles"
         count = listed.count or 1
         if listed.different or (count > 1 and name is None):
@@ -812,6 +853,10 @@ class EmbeddedPlanner:
             return [_one_of(held[0], context) if specific else _name_of(held[0], context)]
         if count == 1 and listed.definite and not is_open(item) and name is None:
             options = list(dict.fromkeys(of[p] for p in pool))
+            spoken_of = state.mentioned_surface
+            there = [p for p, o in zip(pool, seen, strict=False) if spoken_of and _on_surface(o, spoken_of, context)]
+            if len(options) > 1 and len({of[p] for p in there}) == 1:  # "the table's a mess: move the chips"
+                return there[:1]
             if len(options) > 1:  # "the caffeinated one" names one thing, and several fit: ask
                 raise Question(Choice(command="", phrase=item, options=options), _which(options))
         if len(pool) < count:
@@ -1070,6 +1115,12 @@ def _candidates(item: str, context: PlanningContext) -> list[str]:
     return fitting
 
 
+def _kinds_named(words: str, context: PlanningContext) -> list[str]:
+    """The world's objects a phrase names: by name, or every one that fits what it says."""
+    name = _world_name_in(words, context)
+    return [name] if name is not None else _candidates(words, context)
+
+
 def _name_words(item: str, context: PlanningContext) -> set[str]:
     """Words of the phrase that belong to names only (not categories, kinds or colours): "the jalapeno ones"."""
     world = context.world
@@ -1091,8 +1142,9 @@ def _excluded(words: str, context: PlanningContext) -> set[str]:
         name = _world_name_in(part, context)
         if name is not None:
             out.add(name)
-            continue
-        out |= set(_candidates(part, context))
+            if " " in part:
+                continue
+        out |= set(_candidates(part, context))  # "no cola": the coke and the pepsi cola
     return out
 
 
@@ -1114,7 +1166,8 @@ def _same_kind(bare: str, context: PlanningContext) -> list[str]:
 
 
 def _tracked(name: str, context: PlanningContext) -> TrackedObject | None:
-    return next((o for o in context.belief.present() if _name_of(o, context) == name), None)
+    """The believed object a plan's name stands for (the world's name for it, or the robot's own id)."""
+    return next((o for o in context.belief.present() if name in (_name_of(o, context), o.id)), None)
 
 
 def _on_surface(tracked: TrackedObject, surface: str, context: PlanningContext) -> bool:

@@ -36,6 +36,7 @@ class Item:
     every: bool = False  # "all the cans", "every bottle", "everything on the table"
     different: bool = False  # "two different snacks": not two of one kind
     definite: bool = False  # "the caffeinated one" names one thing; "a drink" lets the robot choose
+    alternatives: tuple[str, ...] = ()  # "the pepsi or the coke": any one of these will do
 
 
 @dataclass
@@ -62,6 +63,12 @@ def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
     if excluded is not None:  # "anything but the apple", "a drink that is not fizzy", "not the apple"
         wanted.exclude = _bare(text[excluded.end() :])
         text = text[: excluded.start()].strip()
+    if re.search(r"\bor\b", text):  # "the pepsi or the coke", "a coke, a pepsi or a 7up": one of them
+        text = re.sub(r"^either\s+", "", text)
+        options = tuple(_bare(p) for p in re.split(r"\s*(?:,\s*)?\bor\b\s*|\s*,\s*", text) if _bare(p))
+        if len(options) > 1:
+            wanted.items.append(Item(" or ".join(options), alternatives=options))
+            return wanted
     for part in LIST_BREAK.split(text):
         item = _item(part.strip())
         if item is not None:

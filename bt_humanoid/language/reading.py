@@ -42,6 +42,12 @@ from bt_humanoid.language.lexicon import (
 from bt_humanoid.language.vocabulary import split_clauses, starts_clause
 from bt_humanoid.language.words import normalise
 
+WHERE_IT_WAS = re.compile(
+    r"\s+(?:back\s+)?(?:where|from where) (?:you|i|we) (?:got|found|took|picked up) (?:it|them)(?: from)?\b"
+)
+WHERE_ASIDE = re.compile(r"\s+where (?:she|he|they|nobody|no one|the kids?|it|it will|they will)\b.*$")
+SAID_APART = re.compile(r"\s+(?:but|so|and so)\s+")  # "my mate wants a coke but he can't stand cola"
+SUBJECT_OR_MODAL = re.compile(r"^(?:i|he|she|they|we|it|my|our|can|could|would|will|please)\b")
 MID_FILLER = re.compile(  # words that say nothing wherever they stand
     r"\b(?:when you get there|once you get there|once you are there|when you are there|while you are there|"
     r"while you are at it|once there|one by one|one at a time|in turn)\b"
@@ -54,9 +60,27 @@ IS_CONTRACTED = re.compile(
     r"been|getting|too|very|quite|pretty|such|soft|bad|off|finished|done)\b)",
     re.IGNORECASE,
 )
-HOW_WOULD_YOU = re.compile(r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b", re.IGNORECASE)
-SENTENCE_BREAK = re.compile(r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>|-+)\s+|\n|\s(?:step\s+)?\d+[.)]\s)")
-STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\d+[.)]?|[a-z][.)])\s+")
+HOW_WOULD_YOU = re.compile(
+    r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b"
+    r"|\bwhat(?:'s| is| would be) (?:the|your) (?:\w+ )?(?:way|plan) (?:for you )?(?:to|for getting)?\b",
+    re.IGNORECASE,
+)
+GO_AHEAD = re.compile(
+    r"^(?:(?:go ahead|yes|yeah|ok|okay|then)\s+)*(?:and\s+)?(?:do it|do that|do so|go for it|go ahead|make it so)$"
+)
+REPORTED = re.compile(  # "my doctor says i need more fruit": what they said is the request's context
+    r"^(?:my|our|the|his|her) (?:\w+ ){1,2}(?:says|said|thinks|reckons|told me|tells me)(?: that)?\s+"
+)
+NOT_THAT = re.compile(  # "not spicy though", "not the pepsi, the other one": what the request before must not be
+    r"^(?:but |and )?not (?P<what>(?!(?:sure|really|now|yet)\b).+?)(?:\s+(?:though|tho|please|thanks))?"
+    r"(?:\s*,\s*the other(?: one)?)?$"
+)
+OPEN_BRING = re.compile(r"^(?:bring|get|fetch|grab|give) me (?:something|anything)$")
+ROMAN_STEP = r"(?:i|ii|iii|iv|v|vi|vii|viii|ix|x)[.)]"
+SENTENCE_BREAK = re.compile(  # sentences, arrows, and numbered or lettered steps: "2.", "(2)", "b)", "iii."
+    r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>|-+)\s+|\n|\s(?:step\s+)?\(?\d+[.)]\s|\s\(?[a-h]\)\s|\s" + ROMAN_STEP + r"\s)"
+)
+STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\(?\d+[.)]?|\(?[a-z][.)]|" + ROMAN_STEP + r")\s+")
 MIN_TYPO_LENGTH = 3  # shorter words are too often other words
 TYPO_SCORE = 78.0  # rapidfuzz ratio (0-100) from which a word is taken for a known one
 STATEMENT = re.compile(  # a verb that tells ("the apples are soft"), not in a relative clause ("one that is …")
@@ -83,19 +107,30 @@ def read(text: str, known: frozenset[str]) -> list[str]:
         if not plain:
             continue
         words = [_expand(word) for word in plain.split()]
+        words = [w if w in known or "-" not in w else w.replace("-", " ") for w in words]  # "whole-grain"
         plain = " ".join(w for w in words if w)
         plain = _joined(" ".join(correct(word, known) for word in plain.split()), known)
         plain = MID_FILLER.sub(" ", plain).strip()
+        sure = MAKE_SURE.match(FRAMING_AT_START.sub("", plain))
+        plain = f"put {sure['what']} {sure['where']}" if sure is not None else plain  # "make sure X is on S"
+        plain = re.sub(r"\b(?:and also|as well as)\b", "and", plain)
+        plain = re.sub(r"(?<=\w)\s+(?:and|then|and then)\s+stop(?: there)?$", "", plain)  # "drive up to X and stop"
+        plain = re.sub(r"(?<=\w)\s+(?:first|second|third|next|last|after that)(?=\s*(?:,|$))", "", plain)
+        plain = WHERE_IT_WAS.sub(" back", plain)  # "put it back where you got it"
+        plain = WHERE_ASIDE.sub("", plain)  # "onto the counter where she cannot reach it"
+        plain = re.sub(r"\s+and\s+(?=(?:onto|into|on to|in to|over to)\b)", " ", plain)  # "off A and onto B"
         plain = BOTH_AND.sub("", plain)  # "both the coke and the pepsi": the two named
         plain = re.sub(r"(?<=\w )what(?:ever)?(?: is| there is)?(?= (?:on|in|at|from|off)\b)", "everything", plain)
         pieces: list[str] = []
         # a comma ends a clause before a verb or an aside only; "X goes to A and Y to B" is two
         chunks = [part for chunk in re.split(r"\s*,\s*", plain) for part in BELONGS_BREAK.split(chunk)]
+        chunks = [part for chunk in chunks for part in _said_apart(chunk)]
         for piece in (part for chunk in chunks for part in TOO_BREAK.split(chunk)):
             piece = unframe(piece)
             if not piece:
                 continue
-            if pieces and ANY_WILL_DO.match(piece) and re.search(r"\b(?:a|an|some|something|anything)\b", pieces[-1]):
+            open_before = pieces and re.search(r"\b(?:a|an|some|something|anything|or)\b", pieces[-1])
+            if open_before and ANY_WILL_DO.match(piece):
                 continue  # "get me a drink, any drink": any one will do
             refined = REFINED.match(piece)
             if pieces and refined and pieces[-1].startswith("bring me ") and not starts_clause(piece):
@@ -112,6 +147,7 @@ def read(text: str, known: frozenset[str]) -> list[str]:
                 pieces.append(piece)
         clauses += [clause for piece in _in_order(pieces) for clause in split_clauses(piece)]
     clauses = [unframe(clause) for clause in clauses if unframe(clause)]
+    clauses = _refined(clauses)
     clauses = _avoiding(_topic_first(_in_order(_asked_if_there(clauses))))
     if clauses and all(is_context(c) for c in clauses):  # "my desk is sticky, help": the trouble says what
         trouble = next((TROUBLES[w] for c in clauses for w in c.split() if w in TROUBLES), None)
@@ -127,6 +163,58 @@ def read(text: str, known: frozenset[str]) -> list[str]:
     return [re.sub(r"\b(?:something|anything)$", wanted, c) for c in clauses if c not in NEED_REQUESTS]
 
 
+def _said_apart(chunk: str) -> list[str]:
+    """ "my kid is allergic to apples so get them off the table": broken at "but"/"so" before a new clause only
+    ("anything but the apple" stays whole)."""
+    parts = SAID_APART.split(chunk)
+    out = parts[:1]
+    for part in parts[1:]:
+        if SUBJECT_OR_MODAL.match(part) or starts_clause(unframe(part)):
+            out.append(part)
+        else:
+            out[-1] += (" but " if re.search(rf"\bbut\s+{re.escape(part)}$", chunk) else " so ") + part
+    return out
+
+
+def _refined(clauses: list[str]) -> list[str]:
+    """Clauses that only narrow the request before ("…, not spicy though", "the yellow ones", "any will do")
+    folded into it; "bring me something" dropped where another clause already says what to bring."""
+    out: list[str] = []
+    for clause in clauses:
+        asking = bool(out) and not is_context(out[-1])
+        not_that = NOT_THAT.match(clause)
+        if asking and not_that is not None and not starts_clause(not_that["what"]):
+            out[-1] += f" but not {not_that['what']}"
+            continue
+        if asking and ANY_WILL_DO.match(clause):
+            continue
+        just_one = re.match(r"^(?:(?:just|only)\s+)?(?:one|1|a single)(?:\s+\w+)?$", clause)
+        if asking and just_one is not None:  # "any chips except the spicy ones. just one bag."
+            out[-1] = re.sub(r"\b(?:any|some)\s+(?=\w)", "a ", out[-1], count=1)
+            continue
+        which = re.match(r"^(?:the|those|that)\s+(?P<how>(?:\w+\s+){1,2})(?:one|ones)$", clause)
+        if asking and which is not None:  # "fetch me a packet of crisps. the yellow ones.": yellow crisps
+            out[-1] = _narrowed(out[-1], which["how"].strip())
+            continue
+        out.append(clause)
+    named = [c for c in out if c.startswith("bring me ") and not OPEN_BRING.match(c)]
+    out = [c for c in out if not (OPEN_BRING.match(c) and named)]
+    # "maybe the lime one? yeah, bring me the lime seltzer": a thing said tentatively, then asked for plainly
+    asked = [i for i, c in enumerate(out) if starts_clause(c) and not is_context(c)]
+    return [c for i, c in enumerate(out) if not (TENTATIVE.match(c) and any(j > i for j in asked))]
+
+
+TENTATIVE = re.compile(r"^(?:maybe|perhaps|possibly|probably|like)\s+(?:the|a|an|some)\b")
+
+
+def _narrowed(request: str, how: str) -> str:
+    """ "fetch me a packet of crisps" narrowed by "yellow": "fetch me the yellow crisps"."""
+    thing = re.search(r"\b(?:a|an|some|the|any)\s+(?:(?:\w+)\s+of\s+)?(?P<head>[\w -]+)$", request)
+    if thing is None or DESTINATION_WORDS.search(thing["head"]):
+        return f"{request} , the {how} ones"
+    return f"{request[: thing.start()]}the {how} {thing['head']}"
+
+
 def _in_order(clauses: list[str]) -> list[str]:
     """Clauses in the order to do them: "before you come back, grab the red bull" → grab, then come back;
     "once you've picked up the apple, put it …" → pick up, then put; "if you see a coke, …" names the coke."""
@@ -138,8 +226,10 @@ def _in_order(clauses: list[str]) -> list[str]:
             later.append(_base_form(before["rest"]))
             continue
         once = re.match(r"^(?:once|after|when|as soon as) you(?: have| are)?\s+(?P<rest>.+)$", clause)
+        once = once or re.match(r"^(?:once|after|when|as soon as)\s+(?P<rest>\w+ing\b.+)$", clause)
         if once is not None:
-            clause = _base_form(once["rest"])
+            rest = re.sub(r"^(?:done|finished|through)(?: with)?\s+(?=\w+ing\b)", "", once["rest"])
+            clause = _gerund(rest) if rest.split()[0].endswith("ing") else _base_form(rest)
         seen = re.match(r"^if you (?:see|find|spot|can find) (?P<thing>.+)$", clause)
         if seen is not None:
             clause = f"with {seen['thing']}"
@@ -149,8 +239,9 @@ def _in_order(clauses: list[str]) -> list[str]:
     return out + later
 
 
-ANY_WILL_DO = re.compile(
-    r"^(?:any|anything|whatever|whichever)\b(?:\s+\w+)?(?:\s+(?:is fine|will do|works|you like))?$"
+ANY_WILL_DO = re.compile(  # "any drink", "whichever one is easier to reach", "either is fine"
+    r"^(?:any|anything|whatever|whichever|either)\b"
+    r"(?!.*\b(?:(?:on|in|from|off|at|to)\s+the|but|except|without|other than|not|apart from)\b)(?:\s+\w+){0,5}$"
 )
 PRONOUN = re.compile(r"\b(?:it|them)\b")
 DESTINATION_WORDS = re.compile(r"\b(?:to|into|onto|towards?)\b")
@@ -176,11 +267,15 @@ def _topic_first(clauses: list[str]) -> list[str]:
     return out
 
 
-OFF = re.compile(  # "i'm off sugar this month": what is asked for next must be without it
-    r"^(?:i am|we are|i have gone|we have gone|i went|i have been|i) (?:off|avoiding|cutting out|staying off|"
-    r"not (?:having|drinking|eating))\s+(?P<what>.+?)(?:\s+(?:this|for|at|right|these)\b.*)?$"
+OFF = re.compile(  # "i'm off sugar this month", "he can't stand cola": what is asked for must be without it
+    r"^(?:(?:my|our|the) \w+ |i |we |he |she |they )?(?:am |are |is |have gone |has gone |went |have been |has been )?"
+    r"(?:off|avoiding|cutting out|staying off|allergic to|not (?:having|drinking|eating)|"
+    r"(?:cannot|can not|do not|does not|will not|would not) (?:stand|like|drink|eat|have|do|want|bear|handle))\s+"
+    r"(?P<what>.+?)(?:\s+(?:this|for|at|right|these|anymore|any more|at all)\b.*)?$"
 )
-OPEN_REQUEST = re.compile(r"\b(?:something|anything|a drink|a snack|some\s+\w+)\b")
+OPEN_REQUEST = re.compile(  # a request that leaves the choice open: "something", "a drink", "one", "me caffeine"
+    r"\b(?:something|anything|a drink|a snack|some\s+\w+)\b|^\w+(?: \w+)? one\b|^bring me (?!the\b|my\b|your\b)"
+)
 
 
 def _asked_if_there(clauses: list[str]) -> list[str]:
@@ -195,18 +290,19 @@ def _asked_if_there(clauses: list[str]) -> list[str]:
 
 
 def _avoiding(clauses: list[str]) -> list[str]:
-    """ "i'm off sugar and caffeine, anything i can drink?": the open request after it is made "without" them."""
-    out: list[str] = []
-    avoid: str | None = None
-    for clause in clauses:
-        off = OFF.match(clause)
-        if off is not None:
-            avoid = off["what"]
-            continue
-        if avoid is not None and OPEN_REQUEST.search(clause) and " without " not in clause:
-            clause = f"{clause} without {avoid}"
-        out.append(clause)
-    return out
+    """ "i'm off sugar and caffeine, anything i can drink?", "i need caffeine and i can't stand fizzy drinks": the
+    open requests are made "without" what is avoided. The clause that says so stays, as context ("my kid is
+    allergic to apples, get them off the table": "them")."""
+    avoided = [off["what"] for off in map(OFF.match, clauses) if off is not None]
+    if not avoided:
+        return clauses
+    without = " and ".join(avoided)
+    return [
+        f"{clause} without {without}"
+        if OPEN_REQUEST.search(clause) and " without " not in clause and not OFF.match(clause)
+        else clause
+        for clause in clauses
+    ]
 
 
 def _base_form(clause: str) -> str:
@@ -274,9 +370,16 @@ WOULD_BE = re.compile(
 )
 BELONGS = re.compile(  # "the water bottle needs to go on the table", "the apple belongs in the compost"
     r"^(?P<what>.+?)\s+(?:needs? to|has to|have to|should|must|ought to|can|could|will|would|is to)?\s*"
-    r"(?:go|goes|belongs?|be put|be placed|be moved|be kept|live|lives|stay|stays)\s+"
-    r"(?P<where>(?:back\s+)?(?:on|in|into|onto|on top of|to|inside|over on|next to|by)\s+.+)$"
+    r"(?:go|goes|belongs?|be put|be placed|be moved|be kept|live|lives|stay|stays|be better(?: off)?|look better|"
+    r"fit better|be happier)\s+"
+    r"(?P<where>(?:back\s+)?(?:on|in|into|onto|on top of|to|inside|over on|next to|by)\s+.+?)"
+    r"(?:\s+(?:than|rather than|instead of)\s+.+)?$"
 )
+MAKE_SURE = re.compile(
+    r"^(?:make sure|ensure|see to it|check|double check)(?: that)? (?P<what>.+?) (?:is|are|ends? up|get|gets)"
+    r"(?: all| both| back)? (?P<where>(?:on|in|into|onto|inside|at) .+)$"
+)
+MUST_GO = re.compile(r"^(?P<what>.+?) (?:needs? to|has to|have to|must|should|can) go(?: away)?$")
 PEOPLE_AND_THEN = r"^(?:i|we|you|he|she|they|someone|somebody)\b|\bthen\b"
 # "the kettle chips go to the close counter and the rice chips go to the table": two requests
 BELONGS_BREAK = re.compile(
@@ -321,13 +424,23 @@ def unframe(clause: str) -> str:
     for_me = FOR_ME.match(clause)
     if for_me is not None:  # "could you get the coke for me": get it to me
         clause = f"bring me {for_me['what']}"
+    if GO_AHEAD.match(clause):  # "go ahead and do it": carrying out what was asked, not a request of its own
+        return ""
     previous = None
     while clause != previous:
         previous = clause
+        clause = REPORTED.sub("", clause).strip()
         clause = FILLER_AT_START.sub("", clause).strip()
         clause = FRAMING_AT_START.sub("", clause).strip()
         if not re.match(r"^(?:say|tell|announce)\b", clause):  # what is to be said stays as it is
             clause = FRAMING_AT_END.sub("", clause).strip()
+    sure = MAKE_SURE.match(clause)
+    if sure is not None:  # "make sure the coke and the tea are on the table"
+        return f"put {sure['what']} {sure['where']}"
+    gone = MUST_GO.match(clause)
+    if gone is not None:  # "everything on the table needs to go", "the chips have to go"
+        everything = re.match(r"^(?:everything|all|it all|all of it|all the stuff) (?:on|from|off) ", gone["what"])
+        return f"clear {gone['what'][everything.end() :]}" if everything else f"throw away {gone['what']}"
     belongs = BELONGS.match(clause)
     if belongs is not None and not starts_clause(belongs["what"]) and not re.search(PEOPLE_AND_THEN, belongs["what"]):
         if re.match(r"^(?:in|into|to) (?:my|our) hands?$|^to (?:me|us)$", belongs["where"]):
@@ -349,11 +462,24 @@ def unframe(clause: str) -> str:
     if wanted is not None and clause[wanted.end() :].strip():
         rest = clause[wanted.end() :].strip()
         rest = re.sub(r"^(?:you to|to have|to)\s+", "", rest)
+        rest = re.sub(r"^(?:eat|drink|have|snack on|munch on|try)\s+(?:some\s+)?(?:more\s+)?(?=\w)", "", rest)
         done = DONE_TO.match(rest)
         if done is not None:  # "i want the chips moved to the table"
             return f"{PARTICIPLES[done['done']]} {done['what']} {done['rest']}".strip()
+        if re.search(r"\s(?:over )?there$", rest) and not _starts_with_verb_like(rest):
+            return f"put {rest}"  # "i need the sponge over there": where an aside spoke of
         return rest if _starts_with_verb_like(rest) else f"bring me {rest}"
-    return _gerund(clause)
+    return _gerund(_without_adverb(clause))
+
+
+def _without_adverb(clause: str) -> str:
+    """ "terribly putting the lemonade …" (after "would you mind") → "putting the lemonade …"."""
+    first, _, rest = clause.partition(" ")
+    lemmas = getAllLemmas(first)
+    adverb = first.endswith("ly") and "ADV" in lemmas and not {"NOUN", "VERB"} & set(lemmas)
+    if adverb and rest and (rest.split()[0].endswith("ing") or starts_clause(rest)):
+        return rest
+    return clause
 
 
 def _starts_with_verb_like(text: str) -> bool:

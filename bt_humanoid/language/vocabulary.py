@@ -94,6 +94,7 @@ INTENTS: dict[str, Intent] = {
         (
             *("move", "come", "return", "get", "park", "visit", "stop by", "swing by", "roll", "do a lap"),
             *("make your way", "approach", "check on", "check", "run", "pop over", "nip over"),
+            *("scoot", "zip", "trundle", "wander", "mosey", "stay", "hang out"),
         ),
         ("navigate", "find"),
     ),
