@@ -196,7 +196,7 @@ def test_a_held_thing_is_not_taken_again():
     assert kinds == ["navigate", "give"] and "pick up" not in plan.say
 
 
-@pytest.mark.parametrize("name", ["household_tune", "household_dev"])
+@pytest.mark.parametrize("name", ["household_tune", "household_dev", "household_dev2"])
 def test_the_planner_plans_the_tuning_sets_from_told_scenes(name):
     """The tuning sets (the report set is never tuned on): most planned right with every object told."""
     file = SUITES / f"{name}.yaml"

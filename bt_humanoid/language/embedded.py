@@ -113,9 +113,18 @@ HELD_PHRASE = re.compile(
     r"^(?:(?:the )?(?:thing|one|object|stuff)? ?(?:in|from) your hand|(?:the )?(?:thing |one )?(?:that )?"
     r"(?:what )?you (?:are )?(?:holding|carrying|have)|what you have|what is in your hand)$"
 )
+ONE_OF_A_KIND = re.compile(  # "they love the spicy crisps, put a bag on the table": a bag of those
+    r"(?:a|an|one) (?:bag|can|bottle|packet|pack|piece|box|tin)(?: of (?:them|those|it|these))?(?:\s+(?:out|over))?"
+    r"(?P<but>\s+(?:without|but not)\s.+)?"
+)
+SWAP = re.compile(
+    r"^(?:swap|switch|exchange|trade|swap over|switch over|switch round|swap round)(?: round| around| over)?"
+    r"(?: the places of| the spots of| the positions of| where)? (?P<a>.+?) (?:and|with|for) (?P<b>.+?)"
+    r"(?: are| is)?(?: around| round| over| places| spots| positions)?$"
+)
 POINTED_AT = re.compile(r"^(it|them|that|this|those|these)\s+(?:off|from|out of|on|in)\s+.+$")
 ONE_OF_THOSE = re.compile(  # "bring one over (without cola)": one of what an aside wanted
-    r"(?:one|some|one of those|one of them|something like that)(?:\s+(?:over|here|over here|back))?"
+    r"(?:one|some|one of those|one of them|something like that)(?:\s+(?:over|here|over here|back|out))?"
     r"(?P<but>\s+(?:without|but not)\s.+)?"
 )
 BRING_ONLY = {"bring", "fetch", "deliver", "hand", "give", "pass", "send", "toss"}
@@ -142,6 +151,7 @@ class _State:
     lines: list[str] = field(default_factory=list)
     position: np.ndarray = field(default_factory=lambda: np.zeros(2))  # where the robot will be (x, y)
     surface: str | None = None  # the surface it was last sent to ("leave it there")
+    place: str | None = None  # the place it last went to ("go to the bin and wait there")
     container: str | None = None  # the bin it was last sent to ("drop it in")
     used: set[str] = field(default_factory=set)  # things a step has already claimed ("a drink" twice: two drinks)
     mentioned: str = ""  # an aside that says what is wanted ("my kid wants something sweet"): for "one"
@@ -150,6 +160,7 @@ class _State:
     done: dict[str, tuple[str, str]] = field(default_factory=dict)  # where this plan has already put things
     counted: bool = False  # a count or "every": the answer depends on everything there is
     clear_later: list[str] = field(default_factory=list)  # "clear the table: the cans to the recycling, …"
+    swap_later: list[tuple[str, str]] = field(default_factory=list)  # "swap them: the coke onto the table, …"
     more_to_come: bool = False  # clauses follow the one being planned
 
     @classmethod
@@ -195,6 +206,8 @@ class EmbeddedPlanner:
             state.more_to_come = False
             for rest in state.clear_later:  # what the details after "clear the table" left there
                 self._clear(rest, state, context)
+            for a, b in state.swap_later:
+                self._swap(a, b, state, context)
             if state.pending:
                 raise PlanRefused(f"I can hold one thing at a time; tell me where to put the {_join(state.pending)}.")
         except Question as question:
@@ -302,6 +315,10 @@ class EmbeddedPlanner:
 
     def _act(self, clause: str, state: _State, context: PlanningContext) -> str:
         """A clause read as a frame; NotUnderstood when it has neither a verb the robot knows nor a thing."""
+        swap = SWAP.match(clause)
+        if swap is not None:
+            self._swap(swap["a"], swap["b"], state, context)
+            return "transfer"
         verb, rest = _verb_of(clause)
         if verb is None:
             return self._verbless(clause, state, context)
@@ -375,6 +392,13 @@ class EmbeddedPlanner:
         if _unknown_verb(clause, context):
             raise NotUnderstood(f"I can't {clause}. I can {abilities(context)}.")
         parts = [p for p in re.split(r"\s*,\s*", clause) if p]
+        first_where = _split_destination(parts[0], context, moving=True)
+        bare_things = all(
+            _names_a_thing(p, context) and not _split_destination(p, context, moving=True)[1] for p in parts[1:]
+        )
+        if len(parts) > 1 and first_where[1] and bare_things:
+            destination = parts[0][len(first_where[0]) :]  # "coke to the far counter, pepsi, and the 7up": all there
+            parts = [parts[0]] + [re.sub(r"^and\s+", "", p) + destination for p in parts[1:]]
         if len(parts) > 1 and all(_split_destination(p, context, moving=True)[1] for p in parts):
             for part in parts:  # "red bull onto the table, apple onto the far counter"
                 self._verbless(part, state, context)
@@ -403,6 +427,12 @@ class EmbeddedPlanner:
         restock = re.match(r"^(?P<where>.+?)\s+with\s+(?P<what>.+)$", rest)
         if restock is not None and _destination(restock["where"], context) is not None:
             rest = f"{restock['what']} on {restock['where']}"  # "restock the table with a water bottle"
+        purpose = re.search(rf"\s+(?:{FOR_SOMEONE}|for (?:the|a|our|my|this|tonight's) \w+)$", rest)
+        if purpose and _split_destination(rest[: purpose.start()], context, moving=True)[1] is not None:
+            rest = rest[: purpose.start()]  # "put one on the table for her": the table, not her hands
+        left_here = verb in ("leave", "drop") and re.search(r"\s+here$", rest) is not None
+        if left_here:  # "leave the water here": set down where the robot is, not handed over
+            rest, release = rest[: -len(" here")], True
         if HERE.search(rest) and not (rest.endswith(" back") and verb not in BRING_ONLY):  # "put it back": not me
             to_person, rest = True, HERE.sub("", rest)
         away = re.search(r"(?:^|\s+)away(?:\s+|$)", rest) is not None and verb not in INTENTS["throw_away"].verbs
@@ -465,6 +495,28 @@ class EmbeddedPlanner:
             raise PlanRefused(
                 f"I can carry things to the {_surfaces(context)}, into a bin or to you, not to the {_spoken(name)}."
             )
+
+    def _swap(self, first: str, second: str, state: _State, context: PlanningContext) -> None:
+        """ "swap the energy bar and the apple": each goes to the surface the other stands on."""
+        a, b = self._objects(first, state, context)[0], self._objects(second, state, context)[0]
+        if state.more_to_come:  # "swap them: the red bull onto the table, …": the details first, then the rest
+            state.swap_later.append((a, b))
+            return
+        if a in state.done or b in state.done:
+            return
+        where = {}
+        for name in (a, b):
+            tracked = _tracked(name, context)
+            under = context.belief.surface_under(tracked.position) if tracked is not None else None
+            if under is None:
+                state.counted = True  # a look round may find where it stands
+                raise PlanRefused(f"I can swap things standing on surfaces; I don't know where the {name} stands.")
+            where[name] = under.name
+        if where[a] == where[b]:
+            state.lines.append(f"find the {a} and the {b} both on the {_spoken(where[a])} already")
+            return
+        self._put_on_surface(a, where[b], state, context)
+        self._put_on_surface(b, where[a], state, context)
 
     def _throw(self, verb: str, rest: str, state: _State, context: PlanningContext) -> None:
         takes = BIN_VERBS.get(verb)  # "recycle": a bin for recyclable things
@@ -536,6 +588,8 @@ class EmbeddedPlanner:
             self._go_one(_bare(re.sub(r"^(?:back\s+)?(?:to|round|around|by|at)\s+", "", words)), state, context)
 
     def _go_one(self, where: str, state: _State, context: PlanningContext) -> None:
+        if where == "there" and state.place is not None:
+            where = state.place
         if where in ("back", "home", "back home", "where you started", "your start position", "start position"):
             self._go_to_place(_home(context), state, context)
             return
@@ -543,7 +597,8 @@ class EmbeddedPlanner:
             self._go_to_person(state, context)
             return
         every = re.match(
-            r"^(?:every|each|all(?: the)?|all of the|(?:the )?(?:\d+|two|three|four|five|six)|both)\s+(?P<kind>.+?)s?$",
+            r"^(?:every|each|all(?: the)?(?: \d+| two| three| four| five| six)?|all of the|"
+            r"(?:the )?(?:\d+|two|three|four|five|six)|both(?: the)?)\s+(?P<kind>.+?)s?$",
             where,
         )
         if every is not None:
@@ -615,6 +670,9 @@ class EmbeddedPlanner:
         state.lines.append("come to you")
 
     def _go_to_place(self, place: str, state: _State, context: PlanningContext) -> None:
+        if state.place == place and state.steps and state.steps[-1] == {"navigate": {"place": place}}:
+            return  # "go to the bin and wait there": there already
+        state.place = place
         state.steps.append({"navigate": {"place": place}})
         state.lines.append(f"go to the {_spoken(place)}")
         state.position = np.array(context.world.places[place].pose[:2], dtype=float)
@@ -642,6 +700,9 @@ class EmbeddedPlanner:
         if state.done.get(target) == ("on", surface_name):  # "take it to the table and leave it there": once
             return
         there = _tracked(target, context)
+        alike = [o for o in context.belief.present() if _name_of(o, context) == target]
+        if len(alike) > 1 or (there is not None and there.id != target and _one_of(there, context) != target):
+            there = None  # "apple" when there are two: not necessarily the one already there
         if target not in state.done and state.held != target and there and _on_surface(there, surface_name, context):
             state.lines.append(f"leave the {target} on the {_spoken(surface_name)}, where it is")  # "make sure …"
             state.last = [target]
@@ -727,6 +788,8 @@ class EmbeddedPlanner:
 
     def _objects(self, phrase: str, state: _State, context: PlanningContext) -> list[str]:
         """The objects a phrase names: one, several listed, a count of a kind, or every one of a kind."""
+        if re.fullmatch(r"(?:that|this|the same) one", phrase.strip().strip(" ,")):
+            phrase = "it"  # "pick up the tea and put that one on the table"
         words = _bare(phrase.strip().strip(" ,"))
         words = POINTED_AT.sub(r"\1", words)  # "it off the table": "it" says which, the rest where it is
         if HELD_PHRASE.match(words):
@@ -745,7 +808,7 @@ class EmbeddedPlanner:
             if not state.last:
                 raise PlanRefused("I don't know what 'them' are; name the objects.")
             return list(state.last)
-        one = ONE_OF_THOSE.fullmatch(words)
+        one = ONE_OF_THOSE.fullmatch(words) or ONE_OF_A_KIND.fullmatch(phrase.strip().strip(" ,"))
         if state.mentioned and one is not None:
             phrase = state.mentioned + (one["but"] or "")  # "bring one over": one of what the aside wanted
         count = re.fullmatch(r"(?:a couple|a few|\d+|two|three|four|five|six)(?: of them| of those)?", words)
@@ -774,18 +837,31 @@ class EmbeddedPlanner:
             return
         wanted = read_wanted(re.sub(r"^(?:i|we|someone|my \w+)\s+\w+\s+", "", aside), _surface_words(context))
         for listed in wanted.items:
+            kind_said = ""
             for start in range(len(listed.words.split())):  # the thing is named somewhere in the aside
                 words = " ".join(listed.words.split()[start:])
                 name = _world_name_in(words, context)
+                if name is None and len(words.split()) <= 3 and _candidates(words, context):
+                    kind_said = words  # "she only drinks sparkling water": a kind, not the "water" bottle
+                    continue
+                if name is not None and kind_said:
+                    state.mentioned = kind_said
+                    return
+                kind_said = ""
                 if name is not None:
                     seen = [o for o in context.belief.present() if _world_object(o, context) == name]
                     alike = [_one_of(o, context) for o in seen] or [name]
                     several = bool(listed.every or re.search(r"\b(?:both|all|every)\b", aside))
                     state.counted |= several
                     state.last = alike if several else alike[:1]
+                    state.mentioned = state.mentioned or words  # "they love the spicy crisps, put a bag on the table"
                     return
         wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
-        wants = re.search(r"\b(?:wants|want|needs|need|likes|like|fancies|fancy) (?!to\b)(?P<what>.+)$", aside)
+        wants = re.search(
+            r"\b(?:wants|want|needs|need|likes|like|loves|love|fancies|fancy|prefers|prefer|enjoys|enjoy|drinks|eats|"
+            r"is after|are after|asked for|asks for|only drinks|only eats) (?!to\b)(?P<what>.+)$",
+            aside,
+        )
         # "my kid wants something sweet": "something sweet"; "the kids want snacks": "snacks"
         state.mentioned = wanting.group(0) if wanting else wants["what"] if wants else ""
 
@@ -819,7 +895,8 @@ class EmbeddedPlanner:
         ]
         here = state.position
         seen.sort(key=lambda o: (o.held_by is None, float(np.hypot(*(o.position[:2] - here)))))
-        specific = listed.every or listed.count or wanted.source is not None  # which one matters: by its id
+        twin_used = any(_one_of(o, context) in state.used and _one_of(o, context) != _name_of(o, context) for o in seen)
+        specific = listed.every or listed.count or wanted.source is not None or twin_used  # which one matters: by id
         state.counted |= bool(listed.every or (listed.count or 1) > 1 or wanted.source)
         pool = [_one_of(o, context) if specific else _name_of(o, context) for o in seen]
         of = {name: _world_object(o, context) for name, o in zip(pool, seen, strict=True)}
@@ -830,6 +907,8 @@ class EmbeddedPlanner:
         fresh = [p for p in pool if p not in state.used]
         pool = fresh or pool
         what = item if name is None else name
+        if listed.every and listed.different:  # "one of each sparkling water": one of every kind there is
+            pool = list({of[p]: p for p in reversed(pool)}.values())[::-1]
         if listed.every:
             if not pool:
                 raise PlanRefused(

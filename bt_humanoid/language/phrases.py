@@ -58,11 +58,11 @@ def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
     """Read an object phrase; ``surfaces``: words → surface name (for "from the far counter")."""
     text = " ".join(phrase.split())
     wanted = Wanted(items=[])
-    text, wanted.source = _source(text, surfaces)
     excluded = EXCLUSION.search(text)
     if excluded is not None:  # "anything but the apple", "a drink that is not fizzy", "not the apple"
         wanted.exclude = _bare(text[excluded.end() :])
         text = text[: excluded.start()].strip()
+    text, wanted.source = _source(text, surfaces)  # "the apple from the far counter, not the one on the table"
     if re.search(r"\bor\b", text):  # "the pepsi or the coke", "a coke, a pepsi or a 7up": one of them
         text = re.sub(r"^either\s+", "", text)
         options = tuple(_bare(p) for p in re.split(r"\s*(?:,\s*)?\bor\b\s*|\s*,\s*", text) if _bare(p))
@@ -83,7 +83,7 @@ def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
 def _item(text: str) -> Item | None:
     definite = bool(re.match(r"^(?:the|this|that|these|those|my|your)\b", text))
     text, count, every = _quantity(text)
-    different = DIFFERENT.search(text) is not None
+    different = DIFFERENT.search(text) is not None or re.match(r"^one of (?:each|every)\b", text) is not None
     words = _bare(DIFFERENT.sub("", text))
     if not words:
         return Item("anything", count, every, different, definite) if every or count else None
@@ -106,6 +106,9 @@ def _quantity(text: str) -> tuple[str, int | None, bool]:
     text = (
         re.sub(r"^(?:the|my)\s+", "", text) if re.match(r"^(?:the|my)\s+(?:\d+|two|three|four|five)\b", text) else text
     )
+    each = re.match(r"^one of (?:each|every)(?: kind of| sort of| type of)?(?: (?:of )?the)?\s+", text)
+    if each:  # "one of each sparkling water": every kind once (the caller marks it different)
+        return text[each.end() :], None, True
     for words in sorted(EVERY_WORDS, key=len, reverse=True):
         if text == words or text.startswith(words + " "):
             rest = re.sub(r"^(?:of\s+)?(?:the\s+)?", "", text[len(words) :].strip())

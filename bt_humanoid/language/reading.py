@@ -183,9 +183,10 @@ def _refined(clauses: list[str]) -> list[str]:
     for clause in clauses:
         asking = bool(out) and not is_context(out[-1])
         not_that = NOT_THAT.match(clause)
-        if asking and not_that is not None and not starts_clause(not_that["what"]):
-            out[-1] += f" but not {not_that['what']}"
-            continue
+        if not_that is not None and not starts_clause(not_that["what"]):
+            if asking:
+                out[-1] += f" but not {not_that['what']}"
+            continue  # after a complaint ("i wanted the tea, not the water") it asks nothing
         if asking and ANY_WILL_DO.match(clause):
             continue
         just_one = re.match(r"^(?:(?:just|only)\s+)?(?:one|1|a single)(?:\s+\w+)?$", clause)
@@ -466,8 +467,11 @@ def unframe(clause: str) -> str:
         done = DONE_TO.match(rest)
         if done is not None:  # "i want the chips moved to the table"
             return f"{PARTICIPLES[done['done']]} {done['what']} {done['rest']}".strip()
-        if re.search(r"\s(?:over )?there$", rest) and not _starts_with_verb_like(rest):
-            return f"put {rest}"  # "i need the sponge over there": where an aside spoke of
+        placed = re.search(r"\s(?:over )?there$|\s(?:on|onto|into) (?:the )?\w", rest) and re.match(
+            r"^(?:i|we) (?:need|want|will need|will want|am going to need)\b", clause
+        )
+        if placed and not _starts_with_verb_like(rest):
+            return f"put {rest}"  # "i need the sponge over there", "we need two waters on the table"
         return rest if _starts_with_verb_like(rest) else f"bring me {rest}"
     return _gerund(_without_adverb(clause))
 

@@ -79,7 +79,10 @@ INTENTS: dict[str, Intent] = {
     "bring_here": Intent((), ("bring", "fetch"), ("take", "navigate", "give")),  # "bring the mug here"
     "put": Intent(
         ("put", "place", "set"),
-        ("drop", "leave", "stack", "stash", "store", "stick", "pop", "lay", "stand", "restock", "drop off", "return"),
+        (
+            *("drop", "leave", "stack", "stash", "store", "stick", "pop", "lay", "stand", "restock", "drop off"),
+            *("return", "gather", "round up", "line up"),
+        ),
         ("fetch", "navigate", "place"),
     ),
     # "put it down", "let go of the apple": set what is in hand down on the nearest surface with room
