@@ -185,7 +185,7 @@ class EmbeddedPlanner:
         clauses = read(text, known_words(context))
         if replace is not None:
             clauses = [_replace_phrase(clause, *replace) for clause in clauses]
-        clauses = _same_again(_fetched_to_put(clauses), context)
+        clauses = _telegraphic(_same_again(_fetched_to_put(clauses), context), context)
         if not clauses:
             return Plan("refusal", "I did not hear a command.")
         state = _State.at_start(context)
@@ -652,6 +652,8 @@ class EmbeddedPlanner:
         state.last = last
 
     def _bring(self, target: str, state: _State, context: PlanningContext) -> None:
+        if state.done.get(target) == ("given", "person"):  # "… something to snack on? bring it over": once
+            return
         self._take(target, state, context)
         person = next(iter(context.world.people), None)
         if person is None:
@@ -661,6 +663,7 @@ class EmbeddedPlanner:
         state.lines.append("bring it to you")
         state.held = None
         state.last = [target]
+        state.done[target] = ("given", "person")
 
     def _go_to_person(self, state: _State, context: PlanningContext) -> None:
         person = next(iter(context.world.people), None)
@@ -801,6 +804,8 @@ class EmbeddedPlanner:
             taken, state.pending = state.pending, []  # "grab every can and bin them"
             return taken
         if re.fullmatch(r"(?:it|that|this|that one|this one)", words):
+            if not state.last and state.mentioned:  # "my son needs something healthy, put it on the table"
+                return self._objects(state.mentioned, state, context)
             if not state.last:
                 raise PlanRefused("I don't know what 'it' is; name the object, for example 'the red cube'.")
             return state.last[-1:]
@@ -1022,6 +1027,19 @@ def _same_again(clauses: list[str], context: PlanningContext) -> list[str]:
             what, where = _split_destination(rest, context, moving=True)
             destination = rest[len(what) :].strip() if where is not None and rest.startswith(what) else ""
             out.append(f"{verb} {thing} {destination}".strip())
+        else:
+            out.append(clause)
+    return out
+
+
+def _telegraphic(clauses: list[str], context: PlanningContext) -> list[str]:
+    """ "the coke. table.": a thing, then where it goes, said as two bare words: the thing to that place."""
+    out: list[str] = []
+    for clause in clauses:
+        previous = out[-1] if out else ""
+        a_thing = previous and _verb_of(previous)[0] is None and _names_a_thing(previous, context)
+        if a_thing and _verb_of(clause)[0] is None and _destination(clause, context) is not None:
+            out[-1] = f"{previous} to {clause}"
         else:
             out.append(clause)
     return out

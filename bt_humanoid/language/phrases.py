@@ -73,6 +73,8 @@ def read_wanted(phrase: str, surfaces: dict[str, str]) -> Wanted:
         item = _item(part.strip())
         if item is not None:
             wanted.items.append(item)
+    said = [item.words for item in wanted.items]
+    wanted.items = [item for i, item in enumerate(wanted.items) if item.words not in said[:i]]  # "a cuppa, tea"
     if len(wanted.items) > 1:  # "a snack, anything but the apple": the bare "anything" restates the snack
         wanted.items = [item for item in wanted.items if item.words not in OPEN_WORDS] or wanted.items[:1]
     if not wanted.items and wanted.exclude:

@@ -60,6 +60,11 @@ IS_CONTRACTED = re.compile(
     r"been|getting|too|very|quite|pretty|such|soft|bad|off|finished|done)\b)",
     re.IGNORECASE,
 )
+HELD_THING = re.compile(
+    r"\b(?:the|that|this) (?:\w+ ){1,2}(?:you're|you are|you've got|you have got|you have|u r|ur) "
+    r"(?:holding|carrying|got in your hand|got in your hands)\b",
+    re.IGNORECASE,
+)
 HOW_WOULD_YOU = re.compile(
     r"\bhow (?:would|do|could|can|will|should|might) (?:you|i|we)\b"
     r"|\bwhat(?:'s| is| would be) (?:the|your) (?:\w+ )?(?:way|plan) (?:for you )?(?:to|for getting)?\b",
@@ -81,6 +86,12 @@ SENTENCE_BREAK = re.compile(  # sentences, arrows, and numbered or lettered step
     r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>|-+)\s+|\n|\s(?:step\s+)?\(?\d+[.)]\s|\s\(?[a-h]\)\s|\s" + ROMAN_STEP + r"\s)"
 )
 STEP_NUMBER = re.compile(r"^(?:step\s+\d+|\(?\d+[.)]?|\(?[a-z][.)]|" + ROMAN_STEP + r")\s+")
+UNMARKED = {
+    word.replace("'", ""): full
+    for word, full in CONTRACTIONS.items()
+    if "n't" in word or word in ("i'm", "i've", "you're", "they're", "that's", "what's", "there's")
+}
+HEDGES = {"maybe", "perhaps", "possibly", "probably", "definitely", "actually", "also", "still"}
 MIN_TYPO_LENGTH = 3  # shorter words are too often other words
 TYPO_SCORE = 78.0  # rapidfuzz ratio (0-100) from which a word is taken for a known one
 STATEMENT = re.compile(  # a verb that tells ("the apples are soft"), not in a relative clause ("one that is …")
@@ -88,7 +99,8 @@ STATEMENT = re.compile(  # a verb that tells ("the apples are soft"), not in a r
     r"(?! (?:not )?(?:on|in)\b)"
 )
 SUBJECTS = re.compile(
-    r"^(?:i|we|my|our|it|its|there|this|that|these|those|he|she|they|someone|somebody|the kids?|your|you are)\b"
+    r"^(?:i|we|my|our|it|its|there|this|that|these|those|he|she|they|someone|somebody|the kids?|your|you are|"
+    r"(?:do|does|did) not)\b"
 )
 
 
@@ -100,6 +112,7 @@ def read(text: str, known: frozenset[str]) -> list[str]:
     text = HOW_WOULD_YOU.sub(" ", text)  # "how would you …" asks for the plan: the planner explains and does it
     text = re.sub(r"\b(?:yourself|urself|itself)\b", " ", text, flags=re.IGNORECASE)
     text = IS_CONTRACTED.sub(" is ", text)  # "the table's a mess": "is", not whose
+    text = HELD_THING.sub("what you are holding", text)  # "the can you're holding" ("can you" is not a request)
     clauses = []
     for sentence in SENTENCE_BREAK.split(" " + text.lower() + " "):
         sentence = STEP_NUMBER.sub("", sentence.strip())
@@ -332,6 +345,8 @@ def _expand(word: str) -> str:
         return TYPOS[word]
     if word in CONTRACTIONS:
         return CONTRACTIONS[word]
+    if word in UNMARKED:  # "isnt", "dont": contractions typed without the apostrophe
+        return UNMARKED[word]
     for ending, full in (("'d", " would"), ("'ll", " will"), ("'re", " are"), ("'ve", " have")):
         if word.endswith(ending) and len(word) > len(ending) + 1:  # "it'd", "we'll", "they're"
             return word[: -len(ending)] + full
@@ -393,6 +408,7 @@ GO_AND_STAY = re.compile(r"^(?P<go>go|come|head)(?: and| over and| over)? (?:sta
 ANYTHING_TO = re.compile(
     r"^(?:is there|have you got|have we got|do you have|do we have|got)\s+(?:anything|something)\s+"
     r"(?:(?:that\s+)?(?:i|we)\s+(?:can|could)\s+|to\s+)(?P<verb>drink|eat|snack on|have)\b"
+    r"|^what (?:can|could|should|shall) (?:i|we) (?P<other>drink|eat|snack on|have)\b"
 )
 REFINED = re.compile(r"^(?:preferably|ideally|maybe|like|say)?\s*(?P<what>something\b(?!.*\b(?:but|except)\b).*)$")
 FOR_ME = re.compile(r"^(?:get|grab|fetch|snag|nab|pick up|go get)\s+(?P<what>.+?)\s+for (?:me|us)(?:\s+please)?$")
@@ -425,6 +441,7 @@ def unframe(clause: str) -> str:
     for_me = FOR_ME.match(clause)
     if for_me is not None:  # "could you get the coke for me": get it to me
         clause = f"bring me {for_me['what']}"
+    clause = re.sub(r"\s+if (?:you|we) (?:have|have got|got|can find|can|see) (?:it|one|any|some)$", "", clause)
     if GO_AHEAD.match(clause):  # "go ahead and do it": carrying out what was asked, not a request of its own
         return ""
     previous = None
@@ -452,7 +469,7 @@ def unframe(clause: str) -> str:
     clause = GO_AND_STAY.sub(lambda m: m["go"], clause)  # "go stand by the bin"
     anything = ANYTHING_TO.match(clause)
     if anything is not None:  # "is there anything i can drink?"
-        return f"bring me something to {anything['verb']}"
+        return f"bring me something to {anything['verb'] or anything['other']}"
     would = WOULD_BE.match(clause)
     if would is not None:
         return f"bring me {would['what']}"
@@ -477,10 +494,10 @@ def unframe(clause: str) -> str:
 
 
 def _without_adverb(clause: str) -> str:
-    """ "terribly putting the lemonade …" (after "would you mind") → "putting the lemonade …"."""
+    """ "terribly putting the lemonade …" (after "would you mind") → "putting the lemonade …"; "maybe grab …"."""
     first, _, rest = clause.partition(" ")
     lemmas = getAllLemmas(first)
-    adverb = first.endswith("ly") and "ADV" in lemmas and not {"NOUN", "VERB"} & set(lemmas)
+    adverb = (first.endswith("ly") and "ADV" in lemmas and not {"NOUN", "VERB"} & set(lemmas)) or first in HEDGES
     if adverb and rest and (rest.split()[0].endswith("ing") or starts_clause(rest)):
         return rest
     return clause
