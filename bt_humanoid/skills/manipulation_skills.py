@@ -8,6 +8,7 @@ behaviors/ compose them with recovery.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Literal
 
 import numpy as np
@@ -168,7 +169,10 @@ class _ManipulationSkill(PhasedSkill):
         height = max(carry_height(self.context.world_model, held), *(c.height for c in clearances))
         under = self.context.world_model.surface_under(self._hand_xyz(side))
         if under is not None:  # held up over the things it passes, not carried at their height
-            clearances = [*clearances, *self._keep_clear(side, under)]
+            kept_over = self._keep_clear(side, under)
+            clearances = [*clearances, *kept_over]
+            # a carry pose over one of them (the base close to the counter) is as high as that thing asks
+            height = max([height, *(c.height for c in kept_over if c.covers(xy))])
         # an empty hand turns to its natural yaw; a full one keeps its yaw (as grasped) so nothing swings
         hand_yaw = self._hand_yaw(side) if held is not None else natural_hand_yaw(yaw)
         target = pin.SE3(yaw_rotation(hand_yaw), np.array([*xy, min(height, MAX_CARRY_HEIGHT)]))
@@ -239,6 +243,8 @@ class StandNear(_ManipulationSkill):
         side = self.params.side
         if self.context.world_model.held(side) is not None:
             return None
+        if self.params.object is not None and self._object(self.params.object).held_by is not None:
+            return None
         surface, stance = self._stance()
         x, y, yaw = self.context.robot.base.pose()
         hand = self._hand_xyz(side)
@@ -281,8 +287,10 @@ class StandNear(_ManipulationSkill):
         tucked = config.postures.get(TUCKED_POSTURE, {})
         return self.context.robot.joints.move({j: tucked[j] for j in joints if j in tucked})
 
-    def _drive(self) -> MotionHandle:
+    def _drive(self) -> MotionHandle | None:
         p: StandNearParams = self.params
+        if p.object is not None and self._object(p.object).held_by is not None:
+            return None  # in the hand already (a pick started over after its carry fell short): here is near
         _surface, (x, y, yaw) = self._stance()
         if self._straight_way_blocked(np.array([x, y])):  # the object moved, or we stand on another side
             return self.context.navigator.go_to(np.array([x, y, yaw]), p.max_speed)
@@ -329,15 +337,24 @@ class Grasp(_ManipulationSkill):
             ("clear the view", self._clear_view),
             ("step aside", self._step_aside),
             ("plan", self._plan),
-            ("raise", self._raise),
-            ("pre-grasp", self._pre_grasp),
-            ("descend", self._descend),
-            ("close", self._close),
-            ("check grasp", self._check_grasp),
-            ("lift", self._lift),
-            ("verify", self._verify),
-            ("carry", lambda: self._carry(self.params.side, [self._clearance(self.params.side, self.surface, 0.0)])),
+            ("raise", self._unless_held(self._raise)),
+            ("pre-grasp", self._unless_held(self._pre_grasp)),
+            ("descend", self._unless_held(self._descend)),
+            ("close", self._unless_held(self._close)),
+            ("check grasp", self._unless_held(self._check_grasp)),
+            ("lift", self._unless_held(self._lift)),
+            ("verify", self._unless_held(self._verify)),
+            ("carry", self._carry_taken),
         ]
+
+    def _unless_held(self, phase: Callable[[], MotionHandle | None]) -> Callable[[], MotionHandle | None]:
+        """A phase that is skipped when the hand already holds the object (a retry after the carry failed)."""
+        return lambda: None if self._held_already else phase()
+
+    def _carry_taken(self) -> MotionHandle:
+        surface = self.surface or self.context.world_model.surface_under(self._hand_xyz(self.params.side))
+        clearances = [self._clearance(self.params.side, surface, 0.0)] if surface is not None else []
+        return self._carry(self.params.side, clearances)
 
     def _in_view(self) -> bool:
         """Is the hand on the camera's line of sight to the object (and not behind it)?
@@ -385,6 +402,10 @@ class Grasp(_ManipulationSkill):
     def _plan(self) -> None:
         side = self.params.side
         held = self.context.world_model.held(side)
+        self._held_already, self.surface = False, None
+        if held is not None and held.id == self._object(self.params.object).id:
+            self._held_already = True  # taken already (a carry that fell short): only the carry is left to do
+            return
         if held is not None:
             raise PhaseFailure(f"the {side} hand already holds the {held.name}")
         if self.context.perceiver is not None:

@@ -21,10 +21,13 @@ class ClearanceLimit(Limit):
         self.region = np.asarray(region, dtype=float)
         self.gain = gain
 
+    def covers(self, xy: np.ndarray) -> bool:
+        """Whether the limit holds at ``xy`` (world x, y)."""
+        return bool(np.all(xy[:2] >= self.region[0]) and np.all(xy[:2] <= self.region[1]))
+
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         position = kinematics.pose(self.frame).translation
-        inside = np.all(position[:2] >= self.region[0]) and np.all(position[:2] <= self.region[1])
-        if not inside:
+        if not self.covers(position):
             return Inequality.none(len(kinematics.joints))
         row = kinematics.jacobian(self.frame)[2:3]
         return Inequality(row, np.array([gap_bound(self.gain, self.height - position[2], dt)]))
