@@ -54,6 +54,14 @@ class GroundTruth:
         qpos = self.data.qpos
         return tuple(float(qpos[self.model.joint(joints[a]).qposadr[0]]) for a in ("x", "y", "yaw"))  # type: ignore[return-value]
 
+    def floating_base(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """A legged robot's pelvis: position, rotation (3 × 3), linear and angular velocity, all world frame."""
+        joint = self.model.joint(self.sim.robot.base.root_joint)
+        q = self.data.qpos[joint.qposadr[0] : joint.qposadr[0] + 7]
+        v = self.data.qvel[joint.dofadr[0] : joint.dofadr[0] + 6]
+        rotation = rotation_of(q[3:7])
+        return q[:3].copy(), rotation, v[:3].copy(), rotation @ v[3:6]  # MuJoCo's free joint: ω in the body frame
+
     def bodies_in_contact(self, body: int) -> set[int]:
         """Bodies touching ``body`` now."""
         touching = set()

@@ -56,6 +56,20 @@ class MujocoRobotIO:
         per rad/s (m/s) of velocity error for a velocity actuator."""
         return float(self.sim.model.actuator_gainprm[self.actuator(joint), 0])
 
+    def servo(self, joint: str) -> tuple[float, float, float]:
+        """A position servo's stiffness kp, damping kv and force limit: its force is kp (target − q) − kv q̇,
+        clipped to ± the limit (inf when it has none)."""
+        model = self.sim.model
+        actuator = self.actuator(joint)
+        limit = float(np.max(np.abs(model.actuator_forcerange[actuator])))
+        if not model.actuator_forcelimited[actuator]:
+            limit = np.inf
+        return float(model.actuator_gainprm[actuator, 0]), float(-model.actuator_biasprm[actuator, 2]), limit
+
+    def sensor(self, name: str) -> np.ndarray:
+        """A sensor's reading (the robot's IMU, foot force and touch sensors), as of the last physics step."""
+        return self.sim.data.sensor(name).data
+
     def command(self, actuators: np.ndarray, values: np.ndarray) -> None:
         self.sim.data.ctrl[actuators] = values
 
