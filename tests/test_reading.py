@@ -43,6 +43,21 @@ def known() -> frozenset[str]:
         ("go and stand by the trash can", ["go by the trash can"]),
         ("is there anything I can eat?", ["bring me something to eat"]),
         ("I'm off sugar, anything to drink?", ["i am off sugar", "anything to drink without sugar"]),  # kept: context
+        ("Bring me the pepsi - actually no, make it a coke.", ["bring me a coke"]),
+        ("so thirsty after my run, could you bring me some water pls", ["bring me some water"]),
+        (
+            "got a splitting headache so no caffeine for me today, but I really want something fizzy",
+            ["got a splitting headache", "no caffeine for me today", "bring me something fizzy without caffeine"],
+        ),
+        (
+            "Recycle all the cans on the far counter, but leave the red bull.",
+            ["recycle all the cans on the far counter except the red bull"],
+        ),
+        (
+            "a) go to the far counter b) come back with the lime soda",
+            ["go to the far counter", "bring me the lime soda"],
+        ),
+        ("I need to take a tablet. Could I have some water?", ["i need to take a tablet", "bring me some water"]),
         ("My doctor says I need to eat more fruit. Help me out?", ["bring me fruit"]),
         ("Bring me the cola. Not the Pepsi, the other one.", ["bring me the cola but not the pepsi"]),
         ("a) pepsi to the far counter b) energy bar to me", ["pepsi to the far counter", "energy bar to me"]),

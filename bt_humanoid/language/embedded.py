@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 from lemminflect import getAllLemmas, getLemma
 
+from bt_humanoid.language.lexicon import CATEGORY_WORDS, OPPOSITES
 from bt_humanoid.language.phrases import Item, Wanted, category_words, is_open, read_wanted
 from bt_humanoid.language.plan import Choice, Plan, PlanningContext
 from bt_humanoid.language.reading import is_context, lexicon_words, read
@@ -111,7 +112,8 @@ TAKE_ONLY = {"pick up", "pick", "grasp", "hold", "lift", "collect", "snag", "nab
 TAKE_ONLY |= {"hold on to", "hang on to", "keep hold of", "take hold of", "keep"}
 HELD_PHRASE = re.compile(
     r"^(?:(?:the )?(?:thing|one|object|stuff)? ?(?:in|from) your hand|(?:the )?(?:thing |one )?(?:that )?"
-    r"(?:what )?you (?:are )?(?:holding|carrying|have)|what you have|what is in your hand)$"
+    r"(?:what )?you (?:are )?(?:holding|carrying|have)|what you have(?: got)?(?: in your hands?)?|"
+    r"what is in your hand)$"
 )
 ONE_OF_A_KIND = re.compile(  # "they love the spicy crisps, put a bag on the table": a bag of those
     r"(?:a|an|one) (?:bag|can|bottle|packet|pack|piece|box|tin)(?: of (?:them|those|it|these))?(?:\s+(?:out|over))?"
@@ -122,9 +124,14 @@ SWAP = re.compile(
     r"(?: the places of| the spots of| the positions of| where)? (?P<a>.+?) (?:and|with|for) (?P<b>.+?)"
     r"(?: are| is)?(?: around| round| over| places| spots| positions)?$"
 )
+EVERYTHING_FROM_TO = re.compile(
+    r"^(?:everything|all(?: the things| the stuff| of it)?|the lot|stuff) (?:off|from|on)(?: of)? (?P<source>.+?) "
+    r"(?:over )?(?P<prep>to|onto|on to|into|in to|on) (?P<to>.+)$"
+)
 POINTED_AT = re.compile(r"^(it|them|that|this|those|these)\s+(?:off|from|out of|on|in)\s+.+$")
 ONE_OF_THOSE = re.compile(  # "bring one over (without cola)": one of what an aside wanted
-    r"(?:one|some|one of those|one of them|something like that)(?:\s+(?:over|here|over here|back|out))?"
+    r"(?:one|some|one of those|one of them|something like that|whichever(?: one)?(?: is)?(?: \w+){0,4})"
+    r"(?:\s+(?:over|here|over here|back|out))?"
     r"(?P<but>\s+(?:without|but not)\s.+)?"
 )
 BRING_ONLY = {"bring", "fetch", "deliver", "hand", "give", "pass", "send", "toss"}
@@ -339,6 +346,14 @@ class EmbeddedPlanner:
             _is_bin_phrase(rest, context) or re.match(r"^(?:it|them)?\s*in", rest)
         )
         taking = {"bring_me", "take", "carry_to_surface"} & set(kinds)
+        moved = EVERYTHING_FROM_TO.match(rest)
+        if moved is not None and ({"put", "carry_to_surface"} & set(kinds) or taking):
+            where = _destination(moved["to"], context)
+            if where is not None and where[0] in ("surface", "container"):  # "move everything from A to B"
+                self._transfer(
+                    "put", f"all the things on {moved['source']} {moved['prep']} {moved['to']}", state, context
+                )
+                return "transfer"
         if taking and re.match(r"^(?:everything|all|all the things|the things|stuff) (?:off|from)\s", rest):
             self._clear(rest, state, context)  # "get everything off the table"
             return "clear"
@@ -533,6 +548,10 @@ class EmbeddedPlanner:
 
     def _clear(self, rest: str, state: _State, context: PlanningContext) -> None:
         """Everything believed on a surface moved off it, each to the nearest other surface with room."""
+        rest = re.sub(
+            r"\s*,?\s*(?:everything|all of it|the lot|all)(?: on it| of it)?$", "", rest
+        )  # "…, everything on it"
+        rest = re.sub(r"\s+(?:after|before) (?:lunch|dinner|breakfast|supper|the \w+|my \w+)$", "", rest)
         words = re.sub(r"^(?:everything|all|the things|things|stuff)\s+(?:off|from|on)\s+", "", rest)
         words = re.sub(r"^(?:off|up)\s+", "", words)
         if re.fullmatch(r"(?:it|that|this)(?: up| off)?", words) and state.mentioned_surface is not None:
@@ -810,6 +829,8 @@ class EmbeddedPlanner:
                 raise PlanRefused("I don't know what 'it' is; name the object, for example 'the red cube'.")
             return state.last[-1:]
         if re.fullmatch(r"(?:them|those|these|both|all of them|em|them both|both of them|the two)", words):
+            if not state.last and state.mentioned:  # "my toddler keeps grabbing the chips, put them up high"
+                return self._objects(state.mentioned, state, context)
             if not state.last:
                 raise PlanRefused("I don't know what 'them' are; name the objects.")
             return list(state.last)
@@ -838,8 +859,9 @@ class EmbeddedPlanner:
         surface = _surface_named_in(aside, context)
         if surface is not None:
             state.mentioned_surface = surface  # "the table's a mess, could you clear it?"
-        if state.last:
-            return
+        named = _world_name_in(re.sub(rf"\b(?:on|off|from|in) the {_spoken(surface or '-')}\b", "", aside), context)
+        if state.last and named is None:
+            return  # an aside that names nothing leaves "it" as it was
         wanted = read_wanted(re.sub(r"^(?:i|we|someone|my \w+)\s+\w+\s+", "", aside), _surface_words(context))
         for listed in wanted.items:
             kind_said = ""
@@ -861,6 +883,13 @@ class EmbeddedPlanner:
                     state.last = alike if several else alike[:1]
                     state.mentioned = state.mentioned or words  # "they love the spicy crisps, put a bag on the table"
                     return
+        kinds = re.search(r"\b(?:the|some|those) (?P<kind>[a-z ]+?)$", aside)
+        if named is not None:  # "they are not having the energy drink", "the lime soda's gone flat"
+            state.last = [named]
+            return
+        if kinds is not None and _candidates(kinds["kind"], context) and not state.mentioned:
+            state.mentioned = kinds.group(0)  # "the safest bet is the fruit": "it" is a fruit
+            return
         wanting = re.search(r"\b(?:something|anything|some|a|an)\b.*$", aside)
         wants = re.search(
             r"\b(?:wants|want|needs|need|likes|like|loves|love|fancies|fancy|prefers|prefer|enjoys|enjoy|drinks|eats|"
@@ -891,6 +920,8 @@ class EmbeddedPlanner:
             kinds = list(context.world.objects)  # "anything", "everything"
         excluded = _excluded(wanted.exclude, context)
         kinds = [k for k in kinds if k not in excluded]
+        said_without = _opposite_categories(wanted.exclude, context)  # "without sugar": the unsweetened ones
+        kinds = [k for k in kinds if said_without <= set(context.world.objects[k].categories)] or kinds
         seen = [
             o
             for o in context.belief.present()
@@ -914,6 +945,8 @@ class EmbeddedPlanner:
         what = item if name is None else name
         if listed.every and listed.different:  # "one of each sparkling water": one of every kind there is
             pool = list({of[p]: p for p in reversed(pool)}.values())[::-1]
+        if listed.every and wanted.source is not None:
+            state.mentioned_surface = wanted.source  # "get rid of everything on the table: the chips to the trash"
         if listed.every:
             if not pool:
                 raise PlanRefused(
@@ -921,8 +954,7 @@ class EmbeddedPlanner:
                 )
             return pool
         if listed.definite and not listed.count and name is None and _plural_of_a_kind(item, context):
-            spoken_of = state.mentioned_surface
-            there = [p for p, o in zip(pool, seen, strict=False) if spoken_of and _on_surface(o, spoken_of, context)]
+            there = _on_surface_spoken_of(pool, seen, state, context)
             if there and wanted.source is None:  # "clear the table: recycle the cans": the cans on it
                 return there
             return pool if pool else self._choose(Item(item, every=True), wanted, state, context)  # "the bottles"
@@ -937,8 +969,7 @@ class EmbeddedPlanner:
             return [_one_of(held[0], context) if specific else _name_of(held[0], context)]
         if count == 1 and listed.definite and not is_open(item) and name is None:
             options = list(dict.fromkeys(of[p] for p in pool))
-            spoken_of = state.mentioned_surface
-            there = [p for p, o in zip(pool, seen, strict=False) if spoken_of and _on_surface(o, spoken_of, context)]
+            there = _on_surface_spoken_of(pool, seen, state, context)
             if len(options) > 1 and len({of[p] for p in there}) == 1:  # "the table's a mess: move the chips"
                 return there[:1]
             if len(options) > 1:  # "the caffeinated one" names one thing, and several fit: ask
@@ -1165,10 +1196,12 @@ def _world_name_in(words: str, context: PlanningContext) -> str | None:
     """The world object whose name or alias the words contain (the longest), or None. A category of several
     words is not a name: "sparkling waters" are not the water bottle."""
     text = f" {_canonical(words)} "
-    for category in sorted({c for o in context.world.objects.values() for c in o.categories}, key=len, reverse=True):
+    names = WorldVocabulary.of(context.world).objects
+    categories = {c for o in context.world.objects.values() for c in o.categories}
+    said_of_kinds = {p for p in CATEGORY_WORDS if " " in p and p not in names}  # "fizzy water" is not the water
+    for category in sorted(categories | said_of_kinds, key=len, reverse=True):
         if " " in category:
             text = text.replace(f" {_canonical(category)} ", " ")
-    names = WorldVocabulary.of(context.world).objects
     for name in sorted(names, key=len, reverse=True):
         if f" {_canonical(name)} " in text:
             return context.world.object_of(names[name]) or names[name]
@@ -1245,6 +1278,16 @@ def _excluded(words: str, context: PlanningContext) -> set[str]:
     return out
 
 
+def _opposite_categories(words: str, context: PlanningContext) -> set[str]:
+    """The categories that say positively what an exclusion leaves out ("sugar" → unsweetened), where the world
+    uses them."""
+    if not words:
+        return set()
+    world_categories = {c for o in context.world.objects.values() for c in o.categories}
+    said, _kinds = category_words(_canonical(words), world_categories, set())
+    return {OPPOSITES[c] for group in said for c in group if OPPOSITES.get(c) in world_categories}
+
+
 def _unknown_thing(bare: str, context: PlanningContext) -> bool:
     """A plain noun the world knows nothing by ("banana", "napkin"): no name, kind, category, colour or open word."""
     words = _canonical(bare).split()
@@ -1260,6 +1303,16 @@ def _same_kind(bare: str, context: PlanningContext) -> list[str]:
     if kind is None:
         return []
     return [name for name, o in context.world.objects.items() if o.kind == kind]
+
+
+def _on_surface_spoken_of(
+    pool: list[str], seen: list[TrackedObject], state: _State, context: PlanningContext
+) -> list[str]:
+    """Those of ``pool`` (named for ``seen``, in order) on the surface an aside or a clear spoke of."""
+    surface = state.mentioned_surface
+    if surface is None:
+        return []
+    return [name for name, tracked in zip(pool, seen, strict=False) if _on_surface(tracked, surface, context)]
 
 
 def _tracked(name: str, context: PlanningContext) -> TrackedObject | None:

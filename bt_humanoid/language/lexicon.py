@@ -44,6 +44,9 @@ CATEGORY_WORDS: dict[str, tuple[str, ...]] = {
     "seltzer": ("sparkling water",),
     "seltzers": ("sparkling water",),
     "sparkling water": ("sparkling water",),
+    "fizzy water": ("sparkling water",),
+    "carbonated water": ("sparkling water",),
+    "soda water": ("sparkling water",),
     "sparkling waters": ("sparkling water",),
     "la croix": ("sparkling water",),
     "energy drink": ("energy drink",),
@@ -120,6 +123,9 @@ CATEGORY_WORDS: dict[str, tuple[str, ...]] = {
     "recycling": ("recyclable",),
     "compostable": ("compostable",),
 }
+
+# a category left out → the category that says so positively: "a drink without sugar" is an unsweetened one
+OPPOSITES: dict[str, str] = {"sugary": "unsweetened", "caffeinated": "caffeine-free", "sweet": "unsweetened"}
 
 # words for kinds of container or shape → the kind words worlds use
 KIND_SYNONYMS: dict[str, str] = {
@@ -204,6 +210,10 @@ FRAMING = (
     "right now",
     "now",
     "when you get a chance",
+    "just to be safe",
+    "to be safe",
+    "just in case",
+    "to be on the safe side",
     "when you get a sec",
     "when you get a second",
     "when you have a moment",
@@ -388,6 +398,9 @@ SLANG = {
     "&": "and",
     "w/": "with",
     "lemonade": "lemon lime soda",  # British: a clear lemon-lime fizzy drink
+    "rubbish": "trash",
+    "'em": "them",
+    "em": "them",
     "summat": "something",
     "sumfin": "something",
     "cuppa": "tea",

@@ -46,8 +46,33 @@ WHERE_IT_WAS = re.compile(
     r"\s+(?:back\s+)?(?:where|from where) (?:you|i|we) (?:got|found|took|picked up) (?:it|them)(?: from)?\b"
 )
 WHERE_ASIDE = re.compile(r"\s+where (?:she|he|they|nobody|no one|the kids?|it|it will|they will)\b.*$")
-SAID_APART = re.compile(r"\s+(?:but|so|and so)\s+")  # "my mate wants a coke but he can't stand cola"
-SUBJECT_OR_MODAL = re.compile(r"^(?:i|he|she|they|we|it|my|our|can|could|would|will|please)\b")
+SAID_APART = re.compile(r"\s+(?:but|so|and so|and)\s+")  # "my mate wants a coke but he can't stand cola"
+SUBJECT_OR_MODAL = re.compile(r"^(?:i|he|she|they|we|it|my|our|can|could|would|will|please|no)\b")
+NOTHING_ASKED = ("if so", "if you do", "if we do", "if there is", "if there are")
+REWORDINGS = [  # said another way, read the same
+    (re.compile(p), r)
+    for p, r in (
+        # "recycle it before they see it": when, not what
+        (r"\s+(?:before|so that|so) (?:they|he|she|anyone|someone|somebody|the kids?|nobody|no one) \w+\b.*$", ""),
+        (r"\s+(?:somewhere|anywhere)(?: (?:safe|sensible|nearby|else))?(?=$|\s+and\b)", ""),  # "set it down somewhere"
+        (r"\b(put|get|move|stick|pop|place) (them|it|those|that) up (?=on|onto|there)", r"\1 \2 "),  # "put it up on"
+        (r"\b(?:in the kitchen|in here|around here|in the house|lying around|knocking about)\b", ""),
+        (
+            r"\b(?:before|until|when|once) (?:she|he|they|the kids?|anyone|my \w+) (?:gets?|comes?|arrives?|is|are) "
+            r"(?:here|home|back|in)\b",
+            "",
+        ),  # "before she gets here": when, not what
+        (
+            r"\b(tidy up|clean up|clear up|tidy|clean) (?:after|before) (?:lunch|dinner|breakfast|supper|the party|"
+            r"cooking|the kids|me|us|them)\b",
+            r"\1",
+        ),
+        (r"\bwhat(?:ever)? (?P<x>[a-z]+(?: [a-z]+)?) (?:is|are) (?=(?:on|in|at)\b)", r"all the \g<x> "),
+        (r"\b(them|those) all\b", r"\1"),  # "whatever drinks are on the counter, bring them all"
+        (r"^(?:how would you |how do you )?go about (\w+ing)\b", r"\1"),  # "how would you go about getting me …"
+        (r"\b(?:come|get|head|hurry) back(?: here| to me| over)?(?: and)? with (?!(?:it|them|that)$)", "bring me "),
+    )
+]
 MID_FILLER = re.compile(  # words that say nothing wherever they stand
     r"\b(?:when you get there|once you get there|once you are there|when you are there|while you are there|"
     r"while you are at it|once there|one by one|one at a time|in turn)\b"
@@ -80,7 +105,9 @@ NOT_THAT = re.compile(  # "not spicy though", "not the pepsi, the other one": wh
     r"^(?:but |and )?not (?P<what>(?!(?:sure|really|now|yet)\b).+?)(?:\s+(?:though|tho|please|thanks))?"
     r"(?:\s*,\s*the other(?: one)?)?$"
 )
-OPEN_BRING = re.compile(r"^(?:bring|get|fetch|grab|give) me (?:something|anything)$")
+OPEN_BRING = re.compile(
+    r"^(?:bring|get|fetch|grab|give) me (?:something|anything|one|some)(?: over| here)?(?: without .+)?$"
+)
 ROMAN_STEP = r"(?:i|ii|iii|iv|v|vi|vii|viii|ix|x)[.)]"
 SENTENCE_BREAK = re.compile(  # sentences, arrows, and numbered or lettered steps: "2.", "(2)", "b)", "iii."
     r"(?:[.!?;:]+(?=\s|$)|\s+(?:->|→|=>|-+)\s+|\n|\s(?:step\s+)?\(?\d+[.)]\s|\s\(?[a-h]\)\s|\s" + ROMAN_STEP + r"\s)"
@@ -100,7 +127,7 @@ STATEMENT = re.compile(  # a verb that tells ("the apples are soft"), not in a r
 )
 SUBJECTS = re.compile(
     r"^(?:i|we|my|our|it|its|there|this|that|these|those|he|she|they|someone|somebody|the kids?|your|you are|"
-    r"(?:do|does|did) not)\b"
+    r"(?:do|does|did) not|nobody|no one|everyone|everybody|none of)\b"
 )
 
 
@@ -124,9 +151,16 @@ def read(text: str, known: frozenset[str]) -> list[str]:
         plain = " ".join(w for w in words if w)
         plain = _joined(" ".join(correct(word, known) for word in plain.split()), known)
         plain = MID_FILLER.sub(" ", plain).strip()
+        corrected = CORRECTION.match(plain)
+        asked = OBJECT_AFTER_VERB.match(clauses[-1]) if clauses and corrected else None
+        if corrected is not None and asked is not None:  # "bring me the pepsi - actually no, make it a coke"
+            clauses[-1] = f"{asked['verb']}{corrected['what']}{asked['rest'] or ''}"
+            continue
         sure = MAKE_SURE.match(FRAMING_AT_START.sub("", plain))
         plain = f"put {sure['what']} {sure['where']}" if sure is not None else plain  # "make sure X is on S"
         plain = re.sub(r"\b(?:and also|as well as)\b", "and", plain)
+        for pattern, replacement in REWORDINGS:
+            plain = pattern.sub(replacement, plain)
         plain = re.sub(r"(?<=\w)\s+(?:and|then|and then)\s+stop(?: there)?$", "", plain)  # "drive up to X and stop"
         plain = re.sub(r"(?<=\w)\s+(?:first|second|third|next|last|after that)(?=\s*(?:,|$))", "", plain)
         plain = WHERE_IT_WAS.sub(" back", plain)  # "put it back where you got it"
@@ -179,13 +213,14 @@ def read(text: str, known: frozenset[str]) -> list[str]:
 def _said_apart(chunk: str) -> list[str]:
     """ "my kid is allergic to apples so get them off the table": broken at "but"/"so" before a new clause only
     ("anything but the apple" stays whole)."""
-    parts = SAID_APART.split(chunk)
-    out = parts[:1]
-    for part in parts[1:]:
-        if SUBJECT_OR_MODAL.match(part) or starts_clause(unframe(part)):
+    pieces = re.split(r"\s+(but|so|and so|and)\s+", chunk)
+    out = pieces[:1]
+    for word, part in zip(pieces[1::2], pieces[2::2], strict=True):
+        apart = SUBJECT_OR_MODAL.match(part) or (word != "and" and starts_clause(unframe(part)))
+        if apart and not (word == "and" and not is_context(out[-1])):  # "and" parts only an aside from the rest
             out.append(part)
         else:
-            out[-1] += (" but " if re.search(rf"\bbut\s+{re.escape(part)}$", chunk) else " so ") + part
+            out[-1] += f" {word} {part}"
     return out
 
 
@@ -201,6 +236,10 @@ def _refined(clauses: list[str]) -> list[str]:
                 out[-1] += f" but not {not_that['what']}"
             continue  # after a complaint ("i wanted the tea, not the water") it asks nothing
         if asking and ANY_WILL_DO.match(clause):
+            continue
+        left = LEAVE_OUT.match(clause)
+        if asking and left is not None and re.search(r"\b(?:all|every|everything|both)\b", out[-1]):
+            out[-1] += f" except {left['what']}"  # "recycle all the cans on the far counter, but leave the red bull"
             continue
         just_one = re.match(r"^(?:(?:just|only)\s+)?(?:one|1|a single)(?:\s+\w+)?$", clause)
         if asking and just_one is not None:  # "any chips except the spicy ones. just one bag."
@@ -218,6 +257,19 @@ def _refined(clauses: list[str]) -> list[str]:
     return [c for i, c in enumerate(out) if not (TENTATIVE.match(c) and any(j > i for j in asked))]
 
 
+CORRECTION = re.compile(  # "actually no, make it a coke", "no wait, the blue bag, the chips one"
+    r"^(?:actually|no|nope|wait|sorry|oh|or rather|scratch that|on second thought|i mean)\b[\s,]*"
+    r"(?:(?:actually|no|nope|wait|sorry)\b[\s,]*)*(?:make (?:it|that)|i mean|rather|instead|i meant)?\s*"
+    r"(?P<what>(?:the|a|an|some)\b.+?)(?:\s*,\s*the \w+ ones?)?(?:\s+instead)?$"
+)
+OBJECT_AFTER_VERB = re.compile(
+    r"^(?P<verb>(?:bring|get|grab|fetch|give|hand|pass|pick up|take|put|recycle|compost|throw away|bin)(?: me)? )"
+    r"(?P<what>(?:the|a|an|some|that|this|my)\b.+?)(?P<rest>\s+(?:on|onto|in|into|to)\s+.+)?$"
+)
+LEAVE_OUT = re.compile(
+    r"^(?:but )?(?:leave|keep|skip|not|except|apart from)(?: out)? (?P<what>.+?)"
+    r"(?: alone| there| out| where (?:it|they) (?:is|are))?$"
+)
 TENTATIVE = re.compile(r"^(?:maybe|perhaps|possibly|probably|like)\s+(?:the|a|an|some)\b")
 
 
@@ -281,11 +333,15 @@ def _topic_first(clauses: list[str]) -> list[str]:
     return out
 
 
-OFF = re.compile(  # "i'm off sugar this month", "he can't stand cola": what is asked for must be without it
-    r"^(?:(?:my|our|the) \w+ |i |we |he |she |they )?(?:am |are |is |have gone |has gone |went |have been |has been )?"
-    r"(?:off|avoiding|cutting out|staying off|allergic to|not (?:having|drinking|eating)|"
-    r"(?:cannot|can not|do not|does not|will not|would not) (?:stand|like|drink|eat|have|do|want|bear|handle))\s+"
-    r"(?P<what>.+?)(?:\s+(?:this|for|at|right|these|anymore|any more|at all)\b.*)?$"
+AVOIDING = (
+    r"(?:off|avoiding|avoid|cutting out|cut out|staying off|allergic to|cutting back on|cut back on|cutting down on|"
+    r"cut down on|not (?:having|drinking|eating)|no|"
+    r"(?:cannot|can not|do not|does not|will not|would not) (?:stand|like|drink|eat|have|do|want|bear|handle|touch))"
+)
+OFF = re.compile(  # "i'm off sugar this month", "he can't stand cola", "no caffeine for me": asked for without it
+    r"^(?:(?:my|our|the) (?:[\w-]+ ){1,3}|i |we |he |she |they )?(?:am |are |is |have gone |has gone |went |have been |"
+    r"has been )?(?:trying to |going to )?" + AVOIDING + r"\s+(?:(?:anything|something) with\s+)?"
+    r"(?P<what>.+?)(?:\s+in it)?(?:\s+(?:this|for|at|right|these|anymore|any more|at all|after|today|tonight)\b.*)?$"
 )
 OPEN_REQUEST = re.compile(  # a request that leaves the choice open: "something", "a drink", "one", "me caffeine"
     r"\b(?:something|anything|a drink|a snack|some\s+\w+)\b|^\w+(?: \w+)? one\b|^bring me (?!the\b|my\b|your\b)"
@@ -413,7 +469,8 @@ ANYTHING_TO = re.compile(
 REFINED = re.compile(r"^(?:preferably|ideally|maybe|like|say)?\s*(?P<what>something\b(?!.*\b(?:but|except)\b).*)$")
 FOR_ME = re.compile(r"^(?:get|grab|fetch|snag|nab|pick up|go get)\s+(?P<what>.+?)\s+for (?:me|us)(?:\s+please)?$")
 HAVE_ANY = re.compile(
-    r"^(?:do|have) (?:we|you) (?:have|got) (?:any|some) (?P<what>.+)$|^(?:is|are) there (?:any|some) (?P<other>.+?)"
+    r"^(?:do|have) (?:we|you) (?:still )?(?:have|got) (?:any|some)(?: of (?:those|the|these))? (?P<what>.+)$|"
+    r"^(?:is|are) there (?:still )?(?:any|some)(?: of (?:those|the|these))? (?P<other>.+?)"
     r"(?: left| around| here)?$|^(?:(?:you |we )?got )?any (?P<third>.+?)(?: left| around)?$"
 )
 PARTICIPLES = {
@@ -431,7 +488,8 @@ NEED = re.compile(
 BARE_NEED = re.compile(  # "thirsty af", "so hungry!!": the need alone, said without "i am"
     r"^(?:so\s+|really\s+|absolutely\s+|kinda\s+|super\s+)*(?P<need>"
     + "|".join(NEEDS)
-    + r")(?:\s+(?:af|rn|now|right now|lol|too|as hell|here|over here|today))*$"
+    + r")(?:\s+(?:af|rn|now|right now|lol|too|as hell|here|over here|today))*"
+    r"(?:\s+(?:after|from|because|since|cause|cos)\b.*)?$"  # "so thirsty after my run"
 )
 
 
@@ -442,7 +500,21 @@ def unframe(clause: str) -> str:
     if for_me is not None:  # "could you get the coke for me": get it to me
         clause = f"bring me {for_me['what']}"
     clause = re.sub(r"\s+if (?:you|we) (?:have|have got|got|can find|can|see) (?:it|one|any|some)$", "", clause)
-    if GO_AHEAD.match(clause):  # "go ahead and do it": carrying out what was asked, not a request of its own
+    clause = re.sub(  # "something he can drink": something to drink
+        r"\b(?:something|anything) (?:that )?(?:he|she|they|we|i|you|the kids?) (?:can|could|would|will|might) "
+        r"(?P<verb>drink|eat|have|snack on)\b",
+        r"something to \g<verb>",
+        clause,
+    )
+    clause = re.sub(r"^(?:i|we) (?:really|just|actually|so|kind of|kinda|totally|badly|desperately) ", "i ", clause)
+    allowed = re.match(
+        r"^what (?:is|are) (?P<what>(?:a|an|some) \w+)(?: that)? (?:i|we) (?:am|are|can|could) "
+        r"(?:allowed|have|drink|eat)\b",
+        clause,
+    )
+    if allowed is not None:  # "what's a drink i'm allowed?"
+        return f"bring me {allowed['what']}"
+    if GO_AHEAD.match(clause) or clause in NOTHING_ASKED:  # "go ahead and do it", "if so": nothing more asked
         return ""
     previous = None
     while clause != previous:
@@ -479,6 +551,9 @@ def unframe(clause: str) -> str:
     wanted = WANT_AT_START.match(clause)
     if wanted is not None and clause[wanted.end() :].strip():
         rest = clause[wanted.end() :].strip()
+        own_errand = re.match(r"^to (?!(?:have|eat|drink|snack|munch|try)\b)", rest)
+        if own_errand is not None and not re.match(r"^i (?:would like|want) you\b", clause):
+            return clause  # "i need to take a tablet": what the speaker will do, context for the request
         rest = re.sub(r"^(?:you to|to have|to)\s+", "", rest)
         rest = re.sub(r"^(?:eat|drink|have|snack on|munch on|try)\s+(?:some\s+)?(?:more\s+)?(?=\w)", "", rest)
         done = DONE_TO.match(rest)
@@ -521,8 +596,8 @@ def _gerund(clause: str) -> str:
 def is_context(clause: str) -> bool:
     """A clause that tells something rather than asks: "i knocked my drink over", "the apples are soft",
     "got a meeting in five"."""
-    if SUBJECTS.match(clause) is not None or STATEMENT.search(clause) is not None:
-        return True
+    if SUBJECTS.match(clause) is not None or STATEMENT.search(clause) is not None or OFF.match(clause):
+        return True  # "no caffeine for me today" says what not to bring: context for the request
     first = clause.split()[0] if clause else ""
     lemma = getAllLemmas(first).get("VERB", ("",))[0]
     return bool(lemma) and first != lemma and getInflection(lemma, "VBD") == (first,)  # "knocked", "got", "left"

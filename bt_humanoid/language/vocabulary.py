@@ -209,7 +209,7 @@ class WorldVocabulary:
 
 CLAUSE_BREAK = re.compile(r"\s*(?:,\s*)?(?:\band then\b|\bthen\b|\bafter that\b|\band\b|,)\s*")
 VERB_AT_START = re.compile("^(?:" + "|".join(re.escape(verb) for verb in every_verb()) + r")\b")
-UNJOINED = re.compile(r"\s(?=(?:put|place|bring|go|turn|walk|pick up|grab|find|wave|give me|hand me|come)\b)")
+UNJOINED = re.compile(r"(?<!\bto)\s(?=(?:put|place|bring|go|turn|walk|pick up|grab|find|wave|give me|hand me|come)\b)")
 
 
 def starts_clause(text: str) -> bool:
