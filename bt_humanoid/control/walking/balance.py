@@ -129,7 +129,8 @@ class BalanceController:
         self.com_offset_acceleration = np.zeros(2)
         self.state: BaseState | None = None
         self.solution: IdSolution | None = None
-        self.solve_times: list[float] = []  # s per control step, for the benchmark
+        self.solve_times: list[float] = []  # s per control step building and solving the QP, for the benchmark
+        self.conic_times: list[float] = []  # s of each in DAQP itself
         self.failures = 0  # control steps whose QP had no solution (the last command was held)
 
     # --- the control step ---------------------------------------------------------------------------------------
@@ -153,6 +154,7 @@ class BalanceController:
         self._balance()
         solution = solve_id(self.dynamics, self.contacts, self.tasks, self.bounds, self.torque_limit, self.dt)
         self.solve_times.append(solution.solve_time)
+        self.conic_times.append(solution.conic_time)
         if not solution.solved:
             self.failures += 1
             return  # the motors keep the last torques, the servos their targets

@@ -77,8 +77,8 @@ class StateEstimator:
         if self.model.names[imu.parentJoint] != self.model.names[1]:
             raise ValueError(f"robot '{config.name}': the IMU must sit on the pelvis (the free-flyer's body)")
         self._imu_in_pelvis = imu.placement  # fixed: the IMU is mounted on the pelvis
-        self._dt_matrix = np.eye(12)
-        self._dt_matrix[0:3, 3:6] = dt * np.eye(3)
+        self._diagonal = np.diag_indices(12)
+        self._models: dict[tuple[tuple[bool, bool], float], tuple[np.ndarray, ...]] = {}
         self._contact = [True, True]
         self.x = np.zeros(12)  # IMU position, IMU velocity, left sole, right sole (world)
         self.P = np.eye(12) * INITIAL_POSITION_SPREAD**2
@@ -136,40 +136,27 @@ class StateEstimator:
         x = self.x
         x[0:3] += x[3:6] * dt + 0.5 * acceleration * dt**2
         x[3:6] += acceleration * dt
-        Q = np.zeros(12)
-        Q[0:3] = (0.5 * ACCELEROMETER_NOISE * dt**2) ** 2
-        Q[3:6] = (ACCELEROMETER_NOISE * dt) ** 2
-        for side in (0, 1):
-            drift = STANCE_FOOT_DRIFT if self._contact[side] else SWING_FOOT_DRIFT
-            Q[6 + 3 * side : 9 + 3 * side] = drift**2 * dt
-        F = self._dt_matrix if dt > 0 else np.eye(12)
-        self.P = F @ self.P @ F.T
-        self.P[np.diag_indices(12)] += Q
+        contacts = (self._contact[0], self._contact[1])
+        F, Q, H, noise = self._filter_model(contacts, dt)
+        P = F @ self.P @ F.T
+        P[self._diagonal] += Q
 
         # measurements: each sole relative to the IMU; a standing sole's stillness gives the IMU's velocity
         relative, rates = self._kinematics(joint_positions, joint_velocities)
-        rows, values, noise = [], [], []
+        values = []
         for side in (0, 1):
-            H = np.zeros((3, 12))
-            H[:, 0:3] = -np.eye(3)
-            H[:, 6 + 3 * side : 9 + 3 * side] = np.eye(3)
-            rows.append(H)
-            values.append(rotation @ relative[side])
-            noise.append(np.full(3, KINEMATICS_NOISE**2))
-            if self._contact[side]:
-                H = np.zeros((3, 12))
-                H[:, 3:6] = np.eye(3)
-                rows.append(H)
-                values.append(-np.cross(omega, rotation @ relative[side]) - rotation @ rates[side])
-                noise.append(np.full(3, VELOCITY_NOISE**2))
-        H = np.vstack(rows)
+            offset = rotation @ relative[side]
+            values.append(offset)
+            if contacts[side]:
+                values.append(-_cross(omega, offset) - rotation @ rates[side])
         innovation = np.concatenate(values) - H @ x
-        S = H @ self.P @ H.T
-        S[np.diag_indices(len(S))] += np.concatenate(noise)
-        gain = np.linalg.solve(S, H @ self.P).T  # P Hᵀ S⁻¹ (S and P symmetric)
+        PH = P @ H.T
+        S = H @ PH
+        S[np.diag_indices(len(S))] += noise
+        gain = np.linalg.solve(S, PH.T).T  # P Hᵀ S⁻¹ (S and P symmetric)
         self.x = x + gain @ innovation
-        self.P = (np.eye(12) - gain @ H) @ self.P
-        self.P = 0.5 * (self.P + self.P.T)
+        P = P - gain @ PH.T
+        self.P = 0.5 * (P + P.T)
         self._rotation = rotation
 
         # the pelvis origin from the IMU's point
@@ -179,7 +166,7 @@ class StateEstimator:
         self.state = BaseState(
             position=self.x[0:3] - lever,
             rotation=pelvis_rotation,
-            linear_velocity=self.x[3:6] - np.cross(omega, lever),
+            linear_velocity=self.x[3:6] - _cross(omega, lever),
             angular_velocity=omega,
             contacts=(self._contact[0], self._contact[1]),
         )
@@ -191,6 +178,35 @@ class StateEstimator:
         """Where the filter believes each sole is (world)."""
         return self.x[6:9].copy(), self.x[9:12].copy()
 
+    # --- the filter's matrices ------------------------------------------------------------------------------------
+
+    def _filter_model(self, contacts: tuple[bool, bool], dt: float) -> tuple[np.ndarray, ...]:
+        """F, the process noise Q (diagonal), the measurement matrix H and its noise (diagonal) for these contacts;
+        four combinations, built once each."""
+        key = (contacts, dt)
+        if key not in self._models:
+            F = np.eye(12)
+            F[0:3, 3:6] = dt * np.eye(3)
+            Q = np.zeros(12)
+            Q[0:3] = (0.5 * ACCELEROMETER_NOISE * dt**2) ** 2
+            Q[3:6] = (ACCELEROMETER_NOISE * dt) ** 2
+            rows, noise = [], []
+            for side in (0, 1):
+                drift = STANCE_FOOT_DRIFT if contacts[side] else SWING_FOOT_DRIFT
+                Q[6 + 3 * side : 9 + 3 * side] = drift**2 * dt
+                H = np.zeros((3, 12))  # the sole relative to the IMU: p_sole − p_imu
+                H[:, 0:3] = -np.eye(3)
+                H[:, 6 + 3 * side : 9 + 3 * side] = np.eye(3)
+                rows.append(H)
+                noise.append(np.full(3, KINEMATICS_NOISE**2))
+                if contacts[side]:
+                    H = np.zeros((3, 12))  # the IMU's velocity that a still sole implies
+                    H[:, 3:6] = np.eye(3)
+                    rows.append(H)
+                    noise.append(np.full(3, VELOCITY_NOISE**2))
+            self._models[key] = (F, Q, np.vstack(rows), np.concatenate(noise))
+        return self._models[key]
+
     # --- kinematics ----------------------------------------------------------------------------------------------
 
     def _kinematics(
@@ -199,21 +215,26 @@ class StateEstimator:
         """Each sole's position relative to the IMU and its rate of change, in the IMU's axes."""
         self._q[self._q_index] = joint_positions
         model, data = self.model, self.data
-        placement = self._imu_in_pelvis
         if joint_velocities is None:
-            pin.framesForwardKinematics(model, data, self._q)
-            relative = [placement.rotation.T @ (data.oMf[f].translation - placement.translation) for f in self._soles]
-            return relative, []
-        self._v[self._v_index] = joint_velocities
-        pin.forwardKinematics(model, data, self._q, self._v)
-        pin.updateFramePlacements(model, data)
+            pin.forwardKinematics(model, data, self._q)
+        else:
+            self._v[self._v_index] = joint_velocities
+            pin.forwardKinematics(model, data, self._q, self._v)
+        placement = self._imu_in_pelvis
         relative, rates = [], []
         for frame in self._soles:
-            relative.append(placement.rotation.T @ (data.oMf[frame].translation - placement.translation))
-            # the sole's velocity in the pelvis frame with the pelvis held still: the legs' joint rates alone
-            velocity = pin.getFrameVelocity(model, data, frame, pin.LOCAL_WORLD_ALIGNED).linear
-            rates.append(placement.rotation.T @ velocity)
+            sole = pin.updateFramePlacement(model, data, frame)  # the two soles only, not every frame
+            relative.append(placement.rotation.T @ (sole.translation - placement.translation))
+            if joint_velocities is not None:
+                # the sole's velocity in the pelvis frame with the pelvis held still: the legs' joint rates alone
+                velocity = pin.getFrameVelocity(model, data, frame, pin.LOCAL_WORLD_ALIGNED).linear
+                rates.append(placement.rotation.T @ velocity)
         return relative, rates
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b for 3-vectors (numpy's cross is slow on single vectors)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def _rotation(quaternion: np.ndarray) -> np.ndarray:

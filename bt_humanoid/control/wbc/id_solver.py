@@ -107,8 +107,9 @@ def solve_id(
         h, g = task.objective(dynamics)
         hessian[:nv, :nv] += h
         gradient[:nv] += g
-    hessian[np.arange(nv), np.arange(nv)] += acceleration_weight
-    hessian[np.arange(nv, n), np.arange(nv, n)] += wrench_weight
+    diagonal = hessian.reshape(-1)[:: n + 1]  # a view of the diagonal
+    diagonal[:nv] += acceleration_weight
+    diagonal[nv:] += wrench_weight
     active = [c for c in contacts if c.active]
     weight = dynamics.mass * dynamics.gravity
     for i, contact in enumerate(contacts):

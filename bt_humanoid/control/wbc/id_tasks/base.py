@@ -32,6 +32,8 @@ class AccelerationTask(ABC):
         """(H, g) of this task's cost ½ v̇ᵀ H v̇ + gᵀ v̇ (over v̇ only)."""
         jac = self.jacobian(dynamics)
         residual = self.drift(dynamics) - self.desired(dynamics)
-        weight = np.broadcast_to(np.asarray(self.weight, dtype=float), residual.shape)
-        weighted = jac * weight[:, None]
+        if np.ndim(self.weight) == 0:  # the common case, without broadcasting
+            weighted = jac * float(self.weight)  # type: ignore[arg-type]
+        else:
+            weighted = jac * np.asarray(self.weight, dtype=float)[:, None]
         return jac.T @ weighted, weighted.T @ residual
