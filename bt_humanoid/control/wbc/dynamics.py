@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from bt_humanoid.control.wbc.kinematics import robot_model
+from bt_humanoid.control.wbc.kinematics import cached_frame_id, robot_model
 from bt_humanoid.sim.robot_config import RobotConfig
 
 BASE_DOFS = 6  # the free-flyer's velocity coordinates
@@ -106,11 +106,7 @@ class RobotDynamics:
     # --- frames ------------------------------------------------------------------------------------------------
 
     def frame_id(self, frame: str) -> int:
-        if frame not in self._frame_ids:
-            if not self.model.existFrame(frame):
-                raise KeyError(f"robot has no frame {frame!r}")
-            self._frame_ids[frame] = self.model.getFrameId(frame)
-        return self._frame_ids[frame]
+        return cached_frame_id(self.model, self._frame_ids, frame)
 
     def pose(self, frame: str) -> pin.SE3:
         """World pose of a frame (site, body or joint name)."""

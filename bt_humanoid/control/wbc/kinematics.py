@@ -51,6 +51,15 @@ def _add_camera_frames(model: pin.Model, config: RobotConfig) -> None:
         )
 
 
+def cached_frame_id(model: pin.Model, cache: dict[str, int], frame: str) -> int:
+    """A frame's id in ``model``, looked up once per name (KeyError naming the frame if it has none)."""
+    if frame not in cache:
+        if not model.existFrame(frame):
+            raise KeyError(f"robot has no frame {frame!r}")
+        cache[frame] = model.getFrameId(frame)
+    return cache[frame]
+
+
 class RobotKinematics:
     """Forward kinematics and frame Jacobians over the controlled joints."""
 
@@ -100,11 +109,7 @@ class RobotKinematics:
         return full[np.ix_(self._v_index, self._v_index)]
 
     def frame_id(self, frame: str) -> int:
-        if frame not in self._frame_ids:
-            if not self.model.existFrame(frame):
-                raise KeyError(f"robot has no frame {frame!r}")
-            self._frame_ids[frame] = self.model.getFrameId(frame)
-        return self._frame_ids[frame]
+        return cached_frame_id(self.model, self._frame_ids, frame)
 
     def pose(self, frame: str) -> pin.SE3:
         """World pose of a frame (site, body or camera name)."""
