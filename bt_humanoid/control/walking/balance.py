@@ -125,6 +125,8 @@ class BalanceController:
 
         #: the centre of mass's reference relative to the middle of the feet (x, y, world axes): shifting weight
         self.com_offset = np.zeros(2)
+        self.dcm_gain = DCM_GAIN
+        self.zmp_command = np.zeros(2)  # the balance law's last commanded ZMP (x, y, world)
         self.com_offset_velocity = np.zeros(2)
         self.com_offset_acceleration = np.zeros(2)
         self.state: BaseState | None = None
@@ -177,23 +179,26 @@ class BalanceController:
     def _balance(self) -> None:
         """The tasks' targets: the centre of mass over the middle of the feet (plus the offset), upright, facing
         the way the feet face."""
-        dynamics = self.dynamics
-        left, right = (dynamics.pose(c.frame) for c in self.contacts)
+        left, right = (self.dynamics.pose(c.frame) for c in self.contacts)
         middle = (left.translation + right.translation) / 2
         heading = left.rotation[:, 0] + right.rotation[:, 0]
-        yaw = math.atan2(heading[1], heading[0])
-        reference = np.array([middle[0], middle[1], middle[2] + self.com_height])
-        reference[:2] += self.com_offset
         omega = self.omega
         # the DCM's reference and its rate for a reference moving with ċ_ref, c̈_ref
-        dcm_reference = reference[:2] + self.com_offset_velocity / omega
+        dcm_reference = middle[:2] + self.com_offset + self.com_offset_velocity / omega
         dcm_rate = self.com_offset_velocity + self.com_offset_acceleration / omega
+        self._track(dcm_reference, dcm_rate, float(middle[2]), math.atan2(heading[1], heading[0]))
+
+    def _track(self, dcm_reference: np.ndarray, dcm_rate: np.ndarray, floor: float, yaw: float) -> None:
+        """Targets that track a DCM reference (x, y) and its rate, the centre of mass ``com_height`` above
+        ``floor`` (m), the pelvis and torso upright and facing ``yaw``: the balance law of the module docstring."""
+        dynamics, omega = self.dynamics, self.omega
         com, velocity = dynamics.com, dynamics.com_velocity
         dcm = com[:2] + velocity[:2] / omega
-        zmp = dcm - dcm_rate / omega + DCM_GAIN / omega * (dcm - dcm_reference)
+        zmp = dcm - dcm_rate / omega + self.dcm_gain / omega * (dcm - dcm_reference)
+        self.zmp_command = zmp
         acceleration = np.zeros(3)
         acceleration[:2] = omega**2 * (com[:2] - zmp)
-        self.com.set_target(reference, acceleration=acceleration)
+        self.com.set_target(np.array([com[0], com[1], floor + self.com_height]), acceleration=acceleration)
         upright = pin.rpy.rpyToMatrix(0.0, 0.0, yaw)
         self.pelvis.target = upright
         self.torso.target = upright

@@ -1,0 +1,248 @@
+"""Walking: footsteps, the DCM plan through them, the swinging foot, all on the standing controller's QP.
+
+A gait of fixed timing (docs/walking.md): single support ``SINGLE_SUPPORT`` s, one foot swinging; double support
+``DOUBLE_SUPPORT`` s, the weight passing from one foot to the other. On each new phase the controller plans the
+next footsteps for its velocity command (``FootstepPlanner``), and through them a ZMP reference and the DCM that
+goes with it (``DcmPlan``); every control step the balance law tracks that DCM (``BalanceController._track``) and
+a frame task carries the swinging sole along its ``SwingTrajectory``. The soles' contacts follow the phase: both
+stand in double support, the leaving foot's load ramped down to nothing by lift-off; one stands in single
+support while the other transmits nothing.
+
+A zero command stops: the foot in the air lands where it was going, and one more step brings the feet side by
+side (``brake``: two steps at most), then the robot stands on the standing controller's law.
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+
+import numpy as np
+import pinocchio as pin
+
+from bt_humanoid.control.walking.balance import DCM_GAIN, BalanceController
+from bt_humanoid.control.walking.dcm_plan import DcmPlan
+from bt_humanoid.control.walking.footsteps import LEFT, RIGHT, Footstep, FootstepPlanner, StepLimits
+from bt_humanoid.control.walking.swing import SwingTrajectory
+from bt_humanoid.control.wbc.contact import MIN_NORMAL_FORCE
+from bt_humanoid.control.wbc.id_tasks import FrameTask
+from bt_humanoid.sim.simulation import Simulation
+
+SINGLE_SUPPORT = 0.6  # s with one foot in the air
+DOUBLE_SUPPORT = 0.1  # s passing the weight from foot to foot
+START_SHIFT = 0.6  # s moving the weight onto the first stance foot before the first step
+END_SHIFT = 0.4  # s moving it back to the middle of the feet after the last
+STEP_HEIGHT = 0.05  # m the swinging foot clears the floor
+PLANNED_STEPS = 3  # footsteps planned ahead: the DCM plan's horizon (2.1 s, e^{−ωT} ≈ 4e-4)
+# 1/s: walking's DCM gain. The plan's DCM moves, and a stiff law would throw the centre of pressure to the soles'
+# edges at every small error; the design's 2.5 lets the error decay over a step (docs/walking.md)
+WALKING_DCM_GAIN = 3.0
+SWING_WEIGHT = 30.0
+SWING_GAINS = (400.0, 40.0)  # K_p (1/s²), K_d (1/s): the swing foot follows its path within millimetres
+STILL = 1e-3  # a command below this (m/s, rad/s) is no command
+
+
+class Phase(Enum):
+    STANDING = "standing"
+    DOUBLE = "double support"
+    SINGLE = "single support"
+
+
+class WalkingController(BalanceController):
+    """Walks a legged robot at a commanded body velocity; stands when the command is zero.
+
+    ``command(vx, vy, wz)``: forward and leftward speed (m/s) and turning rate (rad/s) in the body's frame, taken
+    up at the next footstep. ``step()`` as ``BalanceController``: every physics step.
+    """
+
+    def __init__(self, sim: Simulation, posture: str = "home") -> None:
+        super().__init__(sim, posture)
+        legs = self.config.legs
+        assert legs is not None
+        width = legs.stance.width if legs.stance is not None else 0.18
+        self.planner = FootstepPlanner(width, SINGLE_SUPPORT + DOUBLE_SUPPORT, StepLimits())
+        self.swing_tasks = [
+            FrameTask(contact.frame, SWING_WEIGHT, SWING_GAINS[0], SWING_GAINS[1]) for contact in self.contacts
+        ]
+        self._standing_tasks = list(self.tasks)
+        self.velocity = np.zeros(3)
+        self.phase = Phase.STANDING
+        self.phase_start = 0.0
+        self.phase_end = 0.0
+        self.steps: list[Footstep] = []  # planned footsteps, the next (or the swinging foot's) first
+        self.feet: list[Footstep] | None = None  # where each sole stands (measured when it lands)
+        self.swing: SwingTrajectory | None = None
+        self.plan: DcmPlan | None = None
+        self.time = 0.0
+        self.touchdowns: list[Footstep] = []  # every footstep taken, where the sole was at touchdown
+
+    # --- the interface -------------------------------------------------------------------------------------------
+
+    def command(self, vx: float, vy: float = 0.0, wz: float = 0.0) -> None:
+        """Walk at this body velocity (m/s forward, m/s leftward, rad/s turning left) from the next footstep."""
+        self.velocity = np.array([vx, vy, wz], dtype=float)
+
+    def brake(self) -> None:
+        """Stop walking: the swinging foot lands, one more step brings the feet together, and the robot stands."""
+        self.velocity = np.zeros(3)
+
+    @property
+    def walking(self) -> bool:
+        return self.phase is not Phase.STANDING
+
+    # --- the control step ---------------------------------------------------------------------------------------
+
+    def _balance(self) -> None:
+        self.time += self.dt
+        if self.feet is None:
+            self.feet = [self._measured(side) for side in (LEFT, RIGHT)]
+        self._advance()
+        if self.phase is Phase.STANDING:
+            self.dcm_gain = DCM_GAIN
+            super()._balance()
+            return
+        self.dcm_gain = WALKING_DCM_GAIN
+        assert self.plan is not None
+        _, dcm, rate = self.plan.at(self.time)
+        stance = [c.frame for c in self.contacts if c.active]
+        floor = float(np.mean([self.dynamics.pose(frame).translation[2] for frame in stance]))
+        yaw = self._heading()
+        self._track(dcm, rate, floor, yaw)
+
+    def _advance(self) -> None:
+        """Move to the next phase when this one is over; keep the swinging foot's task on its path."""
+        now = self.time
+        moving = bool(np.any(np.abs(self.velocity) > STILL))
+        if self.phase is Phase.STANDING:
+            if moving:
+                self._start_walking(now)
+        elif self.phase is Phase.DOUBLE and now >= self.phase_end:
+            if self.steps:
+                self._lift(now)
+            else:
+                self._stand()
+        elif self.phase is Phase.SINGLE and now >= self.phase_end:
+            self._land(now)
+        self._update_contacts(now)
+
+    def _start_walking(self, now: float) -> None:
+        assert self.feet is not None
+        # the first step swings the foot on the side the robot is going (left for a left turn or sidestep)
+        _, vy, wz = self.velocity
+        first = LEFT if (wz > STILL or (abs(wz) <= STILL and vy > STILL)) else RIGHT
+        stance = self.feet[1 - first]
+        self.steps = self.planner.plan(stance, self.velocity, PLANNED_STEPS)
+        self._double_support(now, START_SHIFT, self._middle())
+
+    def _double_support(self, now: float, duration: float, zmp_from: np.ndarray) -> None:
+        """Begin a double support of ``duration`` moving the ZMP from ``zmp_from`` towards the next stance foot."""
+        self.phase = Phase.DOUBLE
+        self.phase_start, self.phase_end = now, now + duration
+        self._plan_dcm(now, zmp_from)
+
+    def _lift(self, now: float) -> None:
+        step = self.steps[0]
+        pose = self.dynamics.pose(self.contacts[step.side].frame)
+        start = np.array([*pose.translation, _yaw(pose.rotation)])
+        end = np.array([step.x, step.y, self._sole_height(1 - step.side), step.yaw])  # flat floor: the stance's
+        self.swing = SwingTrajectory(start, end, SINGLE_SUPPORT, STEP_HEIGHT)
+        self.phase = Phase.SINGLE
+        self.phase_start, self.phase_end = now, now + SINGLE_SUPPORT
+
+    def _land(self, now: float) -> None:
+        assert self.feet is not None
+        step = self.steps.pop(0)
+        landed = self._measured(step.side)
+        self.feet[step.side] = landed
+        self.touchdowns.append(landed)
+        self.swing = None
+        if np.any(np.abs(self.velocity) > STILL):
+            self.steps = self.planner.plan(landed, self.velocity, PLANNED_STEPS)
+        elif self.planner.together(self.feet[LEFT], self.feet[RIGHT]):
+            self.steps = []
+        else:
+            self.steps = [self.planner.closing_step(landed)]
+        zmp_from = self.feet[1 - step.side].position
+        if self.steps:
+            self._double_support(now, DOUBLE_SUPPORT, zmp_from)
+        else:
+            self._double_support(now, END_SHIFT, zmp_from)
+
+    def _stand(self) -> None:
+        self.phase = Phase.STANDING
+        self.plan = None
+        self.steps = []
+
+    # --- references -----------------------------------------------------------------------------------------------
+
+    def _plan_dcm(self, now: float, zmp_from: np.ndarray) -> None:
+        """The ZMP knots from now through the planned footsteps to standing, and the DCM through them."""
+        assert self.feet is not None
+        times, zmps = [now], [np.asarray(zmp_from, dtype=float)]
+        t = self.phase_end
+        feet = list(self.feet)
+        for step in self.steps:
+            stance = feet[1 - step.side].position
+            times += [t, t + SINGLE_SUPPORT]
+            zmps += [stance, stance]
+            t += SINGLE_SUPPORT + DOUBLE_SUPPORT
+            feet[step.side] = step
+        middle = (feet[LEFT].position + feet[RIGHT].position) / 2
+        if self.steps:
+            times.append(t - DOUBLE_SUPPORT + END_SHIFT)
+        else:
+            times.append(t)
+        zmps.append(middle)
+        self.plan = DcmPlan(times, zmps, self.omega)
+
+    def _update_contacts(self, now: float) -> None:
+        """Which soles stand, how much the leaving one may still carry, and the swinging sole's target."""
+        weight = self.dynamics.mass * self.dynamics.gravity
+        self.tasks = list(self._standing_tasks)
+        for contact in self.contacts:
+            contact.active = True
+            contact.min_normal_force = MIN_NORMAL_FORCE
+            contact.max_normal_force = np.inf
+        if self.phase is Phase.DOUBLE and self.steps:
+            leaving = self.contacts[self.steps[0].side]
+            share = (now - self.phase_start) / max(self.phase_end - self.phase_start, 1e-9)
+            for contact in self.contacts:
+                contact.min_normal_force = 0.0
+            leaving.max_normal_force = max(weight * (1.0 - share), 0.0)
+        elif self.phase is Phase.SINGLE:
+            assert self.swing is not None
+            side = self.steps[0].side
+            self.contacts[side].active = False
+            task = self.swing_tasks[side]
+            pose, velocity, acceleration = self.swing.at(now - self.phase_start)
+            target = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, pose[3]), pose[:3])
+            task.set_target(
+                target,
+                np.array([*velocity[:3], 0.0, 0.0, velocity[3]]),
+                np.array([*acceleration[:3], 0.0, 0.0, acceleration[3]]),
+            )
+            self.tasks.append(task)
+
+    def _heading(self) -> float:
+        """The pelvis's yaw: half-way between the feet, the swinging one where its path has it now."""
+        assert self.feet is not None
+        yaws = [self.feet[LEFT].yaw, self.feet[RIGHT].yaw]
+        if self.phase is Phase.SINGLE and self.swing is not None:
+            side = self.steps[0].side
+            yaws[side] = float(self.swing.at(self.time - self.phase_start)[0][3])
+        return yaws[RIGHT] + math.remainder(yaws[LEFT] - yaws[RIGHT], 2 * math.pi) / 2
+
+    def _middle(self) -> np.ndarray:
+        assert self.feet is not None
+        return (self.feet[LEFT].position + self.feet[RIGHT].position) / 2
+
+    def _measured(self, side: int) -> Footstep:
+        pose = self.dynamics.pose(self.contacts[side].frame)
+        return Footstep(side, float(pose.translation[0]), float(pose.translation[1]), _yaw(pose.rotation))
+
+    def _sole_height(self, side: int) -> float:
+        return float(self.dynamics.pose(self.contacts[side].frame).translation[2])
+
+
+def _yaw(rotation: np.ndarray) -> float:
+    return math.atan2(rotation[1, 0], rotation[0, 0])
