@@ -95,7 +95,14 @@ class FootstepPlanner:
         # the body moves along an arc's chord: the velocity taken in the frame half-way through the turn
         c, s = math.cos(dyaw / 2), math.sin(dyaw / 2)
         dx, dy = (c * vx - s * vy) * self.period, (s * vx + c * vy) * self.period
-        target = body.moved(dx, dy, dyaw, side).moved(0.0, SIDE_SIGN[side] * self.width / 2, 0.0, side)
+        # sideways and turning, the leading foot opens by two steps' worth and the other closes onto it: the feet
+        # never come closer than they stand, nor turn inwards (the box allows little of either), and a pair of
+        # steps still moves by 2 vy T and turns by 2 wz T
+        sideways = vy * self.period * (1.0 if vy * SIDE_SIGN[side] > 0.0 else -1.0)
+        target = body.moved(dx, dy, dyaw, side).moved(0.0, SIDE_SIGN[side] * self.width / 2 + sideways, 0.0, side)
+        opening = wz * SIDE_SIGN[side] > 0.0
+        turned = stance.moved(0.0, 0.0, 2 * dyaw if opening else 0.0, side)
+        target = Footstep(side, target.x, target.y, turned.yaw)
         return self.limits.clip(target, stance)
 
     def plan(self, stance: Footstep, velocity: np.ndarray, count: int) -> list[Footstep]:
