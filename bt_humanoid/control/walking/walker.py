@@ -23,7 +23,7 @@ import pinocchio as pin
 from bt_humanoid.control.walking.balance import DCM_GAIN, BalanceController
 from bt_humanoid.control.walking.dcm_plan import DcmPlan
 from bt_humanoid.control.walking.footsteps import LEFT, RIGHT, Footstep, FootstepPlanner, StepLimits
-from bt_humanoid.control.walking.swing import SwingTrajectory
+from bt_humanoid.control.walking.swing import LIFT_SHARE, SwingTrajectory
 from bt_humanoid.control.wbc.contact import MIN_NORMAL_FORCE
 from bt_humanoid.control.wbc.id_tasks import FrameTask
 from bt_humanoid.sim.simulation import Simulation
@@ -36,9 +36,16 @@ STEP_HEIGHT = 0.05  # m the swinging foot clears the floor
 PLANNED_STEPS = 3  # footsteps planned ahead: the DCM plan's horizon (2.1 s, e^{−ωT} ≈ 4e-4)
 # 1/s: walking's DCM gain. The plan's DCM moves, and a stiff law would throw the centre of pressure to the soles'
 # edges at every small error; the design's 2.5 lets the error decay over a step (docs/walking.md)
-WALKING_DCM_GAIN = 3.0
+WALKING_DCM_GAIN = 6.0
 SWING_WEIGHT = 30.0
 SWING_GAINS = (400.0, 40.0)  # K_p (1/s²), K_d (1/s): the swing foot follows its path within millimetres
+# m of DCM error that the ankles take and the footstep ignores; beyond it the footstep moves (_adjust_step)
+ADJUSTMENT_DEADBAND = 0.04
+# where a footstep may go to recover from a push: further than walking's steps, as far as the legs reach
+RECOVERY_LIMITS = StepLimits(forward=(-0.25, 0.35), sideways=(0.14, 0.40), yaw=(-0.1, 0.4))
+MIN_SWING = 0.3  # s: the shortest a swing may be made to land a pushed robot's foot sooner
+TIMING_CANDIDATES = 8  # landing times tried, from the nominal one to the soonest
+REACH_TOLERANCE = 0.01  # m: a footstep this near to the one wanted is as good
 STILL = 1e-3  # a command below this (m/s, rad/s) is no command
 
 
@@ -74,6 +81,9 @@ class WalkingController(BalanceController):
         self.swing: SwingTrajectory | None = None
         self.plan: DcmPlan | None = None
         self.time = 0.0
+        self._nominal_step: Footstep | None = None  # the swinging foot's planned footstep, before adjustment
+        self._touchdown_dcm = np.zeros(2)
+        self.dcm_error = 0.0  # m between the DCM and the plan's, last computed in single support
         self.touchdowns: list[Footstep] = []  # every footstep taken, where the sole was at touchdown
 
     # --- the interface -------------------------------------------------------------------------------------------
@@ -146,8 +156,11 @@ class WalkingController(BalanceController):
         start = np.array([*pose.translation, _yaw(pose.rotation)])
         end = np.array([step.x, step.y, self._sole_height(1 - step.side), step.yaw])  # flat floor: the stance's
         self.swing = SwingTrajectory(start, end, SINGLE_SUPPORT, STEP_HEIGHT)
+        self._nominal_step = step
         self.phase = Phase.SINGLE
         self.phase_start, self.phase_end = now, now + SINGLE_SUPPORT
+        assert self.plan is not None
+        self._touchdown_dcm = self.plan.at(self.phase_end)[1]  # where the plan has the DCM at touchdown
 
     def _land(self, now: float) -> None:
         assert self.feet is not None
@@ -211,6 +224,7 @@ class WalkingController(BalanceController):
             leaving.max_normal_force = max(weight * (1.0 - share), 0.0)
         elif self.phase is Phase.SINGLE:
             assert self.swing is not None
+            self._adjust_step(now)
             side = self.steps[0].side
             self.contacts[side].active = False
             task = self.swing_tasks[side]
@@ -222,6 +236,49 @@ class WalkingController(BalanceController):
                 np.array([*acceleration[:3], 0.0, 0.0, acceleration[3]]),
             )
             self.tasks.append(task)
+
+    def _adjust_step(self, now: float) -> None:
+        """Move the swinging foot's footstep, and land it sooner, where it captures the DCM (docs/walking.md,
+        step adjustment; after Khadiv et al., "Walking control based on step timing adaptation", 2020).
+
+        Held on the stance sole's centre p, the DCM moves as ξ(t) = p + (ξ − p) e^{ω t}: by a touchdown τ s from
+        now it is at ξ_τ, and a footstep at ξ_τ − b, b the plan's DCM offset from the footstep at touchdown,
+        carries on as planned from there. The nominal landing time is kept while its footstep is within what
+        the legs can reach (``RECOVERY_LIMITS``); otherwise the foot lands sooner, as soon as the swing allows
+        (``MIN_SWING``), where the DCM has gone less far. Errors the ankles can take (``ADJUSTMENT_DEADBAND``)
+        move nothing; once the foot is coming down, nothing changes.
+        """
+        elapsed, remaining = now - self.phase_start, self.phase_end - now
+        if self.plan is None or self.feet is None or remaining < LIFT_SHARE * SINGLE_SUPPORT:
+            return
+        nominal = self._nominal_step
+        assert self.swing is not None and nominal is not None
+        stance = self.feet[1 - nominal.side]
+        _, dcm_reference, _ = self.plan.at(now)
+        self.dcm_error = float(np.linalg.norm(self.dcm() - dcm_reference))
+        if self.dcm_error <= ADJUSTMENT_DEADBAND:
+            return
+        pivot, dcm = stance.position, self.dcm()
+        offset = self._touchdown_dcm - nominal.position  # b
+        shortest = max(MIN_SWING - elapsed, LIFT_SHARE * SINGLE_SUPPORT)
+        best: tuple[float, float, Footstep] | None = None
+        for duration in np.linspace(remaining, min(shortest, remaining), TIMING_CANDIDATES):
+            needed = pivot + (dcm - pivot) * math.exp(self.omega * duration) - offset
+            shift = needed - nominal.position  # less the deadband, which the ankles take
+            shift *= max(1.0 - ADJUSTMENT_DEADBAND / max(float(np.linalg.norm(shift)), 1e-9), 0.0)
+            wanted = Footstep(nominal.side, nominal.x + shift[0], nominal.y + shift[1], nominal.yaw)
+            target = RECOVERY_LIMITS.clip(wanted, stance)
+            miss = float(np.linalg.norm(target.position - wanted.position))
+            if best is None or miss < best[0] - REACH_TOLERANCE:
+                best = (miss, float(duration), target)
+            if miss <= REACH_TOLERANCE:
+                break
+        assert best is not None
+        _, duration, target = best
+        if target != self.steps[0] or duration < remaining - 1e-9:
+            self.steps[0] = target
+            self.phase_end = now + duration
+            self.swing.retarget(elapsed, np.array([target.x, target.y, target.yaw]), elapsed + duration)
 
     def _heading(self) -> float:
         """The pelvis's yaw: half-way between the feet, the swinging one where its path has it now."""
