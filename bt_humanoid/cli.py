@@ -72,7 +72,11 @@ def _run_parser() -> argparse.ArgumentParser:
 def _command_arguments(parser: argparse.ArgumentParser, command_help: str) -> None:
     parser.add_argument("--command", metavar="TEXT", help=command_help)
     parser.add_argument("--world", default="apartment", help="world of a command (default: apartment)")
-    parser.add_argument("--robot", default="wheeled_humanoid", help="robot of a command (default: wheeled_humanoid)")
+    parser.add_argument(
+        "--robot",
+        help="robot to run on: a command's (default: wheeled_humanoid), or one over a mission file's own "
+        "(biped_humanoid walks a base-motion mission)",
+    )
     parser.add_argument(
         "--scene",
         metavar="NAME|FILE",
@@ -109,14 +113,14 @@ def run_main(argv: list[str] | None = None) -> int:
             args.command = _heard_command(args, console)
         if args.command is not None:
             # one robot from its first look to its last step: the plan comes from what this stack believes
-            stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=speech, scene=args.scene)
+            stack = RobotStack.load(args.world, _robot(args), args.seed or 0, speak=speech, scene=args.scene)
             outcome = _plan_from_command(args, console, stack)
             if outcome.spec is None:
                 stack.close()
                 return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
             spec = outcome.spec
         else:
-            spec = MissionLoader(scene=args.scene).load_file(args.mission)
+            spec = MissionLoader(scene=args.scene, robot=args.robot).load_file(args.mission)
             stack = stack_for(spec, args.seed, speak=speech)
         run = MissionRun(stack, spec, tick_hz=args.tick_hz)
         recorder = None
@@ -165,6 +169,11 @@ def run_main(argv: list[str] | None = None) -> int:
     if args.events:
         result.events.write(args.events)
     return EXIT_OK if result.success else EXIT_FAILED
+
+
+def _robot(args: argparse.Namespace) -> str:
+    """The robot a command (typed, spoken or interactive) runs on: --robot, else the wheeled humanoid."""
+    return args.robot or "wheeled_humanoid"
 
 
 def _pace_to_wall_clock(stack) -> None:  # a RobotStack (imported late: it loads MuJoCo)
@@ -269,7 +278,7 @@ def _interactive(args: argparse.Namespace, console: Console) -> int:
         from bt_humanoid.engine.stack import RobotStack
 
         planner = _planner(args)
-        stack = RobotStack.load(args.world, args.robot, args.seed or 0, speak=say, scene=args.scene)
+        stack = RobotStack.load(args.world, _robot(args), args.seed or 0, speak=say, scene=args.scene)
         session = InteractiveSession(stack, lines, say, planner)
         if args.listen:
             relay = _listener_thread(args, lines, session, console)
@@ -374,7 +383,7 @@ def plan_main(argv: list[str] | None = None) -> int:
     try:
         from bt_humanoid.engine.stack import RobotStack
 
-        stack = RobotStack.load(args.world, args.robot, scene=args.scene)
+        stack = RobotStack.load(args.world, _robot(args), scene=args.scene)
         outcome = _plan_from_command(args, console, stack)
     except UserError as error:
         return _fail_invalid(error)

@@ -10,11 +10,11 @@ falls far behind its plan is blocked: the goal fails and the base brakes.
 from __future__ import annotations
 
 import math
-from typing import Protocol
 
 import numpy as np
 from ruckig import Trajectory
 
+from bt_humanoid.control.base_motion import SpeedMonitoring
 from bt_humanoid.control.motion import MotionHandle, plan_trajectory
 from bt_humanoid.sim.robot_config import BaseConfig
 from bt_humanoid.sim.robot_io import MujocoRobotIO
@@ -30,25 +30,12 @@ BRAKE_ACCEL = 4.0  # × the base's acceleration limits when braking
 BRAKE_JERK = 20.0  # × its jerk limits when braking
 
 
-HELD_SHARE = 0.05  # a motion allowed less than this share of its speed is held (a protective stop)
-
-
-class SpeedLimiter(Protocol):
-    """Says how much of a planned base velocity may run now (speed and separation monitoring does)."""
-
-    hold_limit: float  # s a motion may be held before it fails
-
-    def share(self, velocity: np.ndarray) -> float: ...
-
-    def describe(self) -> str: ...
-
-
 def wrap_angle(angle: float) -> float:
     """Angle in [-pi, pi)."""
     return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
-class BaseDriver:
+class BaseDriver(SpeedMonitoring):
     """Pose goals for the base, executed through velocity actuators (the wheeled robot's BaseMotion)."""
 
     def __init__(self, io: MujocoRobotIO, config: BaseConfig) -> None:
@@ -65,35 +52,17 @@ class BaseDriver:
         self.target = self.reference.copy()
         self.braking = False
         self.tracking = False  # following references streamed by the whole-body controller
-        self.limiter: SpeedLimiter | None = None  # slows planned motions near people and things sensed
+        self.limiter = None  # slows planned motions near people and things sensed
         self.elapsed = 0.0  # s along the current plan: runs slower than the clock while the limiter slows it
         self.last_step = io.time
         self.planned_velocity = np.zeros(3)  # the plan's velocity at ``elapsed``, before the limiter's share
-        self.held_since: float | None = None  # when the limiter stopped the plan
+        self.held_since = None  # when the limiter stopped the plan
         self.speed_cap = config.limits.max_speed  # m/s: the mission's cap (safety: max_base_speed), set per run
 
     def capped(self, requested: float | None = None) -> float:
         """The speed a motion may plan for: what it asks (None: as fast as allowed) under the mission's cap and
         the base's limit. The one place the cap is applied: skills ask for speeds, the base decides."""
         return min(requested if requested is not None else math.inf, self.speed_cap, self.config.limits.max_speed)
-
-    def allowed_share(self, velocity: np.ndarray) -> float:
-        """The share (0 to 1) of ``velocity`` (vx, vy, yaw rate; world frame) the base may run at now."""
-        return self.limiter.share(velocity) if self.limiter is not None else 1.0
-
-    def reset_hold(self) -> None:
-        """A new motion: a protective stop holding it starts counting afresh."""
-        self.held_since = None
-
-    def held_too_long(self, share: float, now: float) -> str | None:
-        """Track a protective stop; the reason to give up once it has held a motion for the limiter's hold limit."""
-        if share >= HELD_SHARE or self.limiter is None:
-            self.held_since = None
-            return None
-        self.held_since = now if self.held_since is None else self.held_since
-        if now - self.held_since <= self.limiter.hold_limit:
-            return None
-        return f"held {now - self.held_since:.0f} s by a protective stop: {self.limiter.describe()}"
 
     @property
     def time(self) -> float:

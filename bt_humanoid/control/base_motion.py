@@ -60,3 +60,42 @@ class BaseMotion(Protocol):
     def held_too_long(self, share: float, now: float) -> str | None:
         """Why to give up once a protective stop has held a motion too long; None until then."""
         ...
+
+
+HELD_SHARE = 0.05  # a motion allowed less than this share of its speed is held (a protective stop)
+
+
+class SpeedLimiter(Protocol):
+    """Says how much of a planned base velocity may run now (speed and separation monitoring does)."""
+
+    hold_limit: float  # s a motion may be held before it fails
+
+    def share(self, velocity: np.ndarray) -> float: ...
+
+    def describe(self) -> str: ...
+
+
+class SpeedMonitoring:
+    """The part of ``BaseMotion`` every base answers alike: the share of a velocity that speed and separation
+    monitoring allows, and how long a protective stop has held a motion."""
+
+    limiter: SpeedLimiter | None = None  # slows planned motions near people and things sensed
+    held_since: float | None = None  # when the limiter stopped the motion
+
+    def allowed_share(self, velocity: np.ndarray) -> float:
+        """The share (0 to 1) of ``velocity`` (vx, vy, yaw rate; world frame) the base may run at now."""
+        return self.limiter.share(velocity) if self.limiter is not None else 1.0
+
+    def reset_hold(self) -> None:
+        """A new motion: a protective stop holding it starts counting afresh."""
+        self.held_since = None
+
+    def held_too_long(self, share: float, now: float) -> str | None:
+        """Track a protective stop; the reason to give up once it has held a motion for the limiter's hold limit."""
+        if share >= HELD_SHARE or self.limiter is None:
+            self.held_since = None
+            return None
+        self.held_since = now if self.held_since is None else self.held_since
+        if now - self.held_since <= self.limiter.hold_limit:
+            return None
+        return f"held {now - self.held_since:.0f} s by a protective stop: {self.limiter.describe()}"

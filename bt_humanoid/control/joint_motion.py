@@ -37,10 +37,13 @@ class _Goal:
 class JointReferenceController:
     """Jerk-limited joint references for the arms, waist, head and fingers."""
 
-    def __init__(self, io: MujocoRobotIO, config: RobotConfig) -> None:
+    def __init__(self, io: MujocoRobotIO, config: RobotConfig, driven: list[str] | None = None) -> None:
         self.io = io
         self.joints = io.joints
         self.actuators = np.array([io.actuator(j) for j in self.joints])
+        # the joints whose servos take these references; the others' (a walking robot's upper body) take the
+        # balance controller's targets, which follow these references as its posture task
+        self._driven = np.arange(len(self.joints)) if driven is None else self.indices(list(driven))
         self.limits = tuple(
             np.array([getattr(config.motion_limits(j), kind) for j in self.joints])
             for kind in ("velocity", "acceleration", "jerk")
@@ -115,7 +118,8 @@ class JointReferenceController:
             self.velocity[goal.joints] = 0.0
             self.acceleration[goal.joints] = 0.0
             self._finish(goal, measured, elapsed)
-        self.io.command(self.actuators, self.position + self.feedforward)
+        driven = self._driven
+        self.io.command(self.actuators[driven], (self.position + self.feedforward)[driven])
 
     def _finish(self, goal: _Goal, measured: np.ndarray, elapsed: float) -> None:
         if goal.target is None or not goal.settle_check:

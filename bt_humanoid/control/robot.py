@@ -11,11 +11,13 @@ from typing import Protocol
 
 import numpy as np
 
-from bt_humanoid.control.base_driver import BaseDriver, SpeedLimiter
+from bt_humanoid.control.base_driver import BaseDriver
+from bt_humanoid.control.base_motion import BaseMotion, SpeedLimiter
 from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.inertial_feedforward import BaseAccelerationFeedforward
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.motion import REST_SPEED
+from bt_humanoid.control.walking.walking_base import WalkingBase
 from bt_humanoid.control.whole_body import WholeBodyController
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.robot_io import MujocoRobotIO
@@ -41,15 +43,30 @@ class RobotController:
 
     def __init__(self, sim: Simulation) -> None:
         self.config: RobotConfig = sim.robot
-        base_joints = [self.config.base.joints[axis] for axis in ("x", "y", "yaw")]
-        self.body_io = MujocoRobotIO(sim, self.config.actuated_joints)
-        self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)  # skills see its BaseMotion
-        self.joints = JointReferenceController(self.body_io, self.config)
+        self.walking: WalkingBase | None = None
+        if self.config.base.floating:  # legs: the walking controller drives them, and the upper body's servos
+            self.walking = WalkingBase(sim)
+            legs = self.config.legs
+            assert legs is not None
+            self.body_io = MujocoRobotIO(sim, [j for j in self.config.actuated_joints if j not in legs.joints])
+            self.base: BaseMotion = self.walking  # skills see its BaseMotion
+            driven = [j for j in self.walking.walker.held if j in self.body_io.joints]  # the fingers
+            self.joints = JointReferenceController(self.body_io, self.config, driven=driven)
+            self._upper_body = self.joints.indices(self.walking.walker.upper_body.joints)
+        else:
+            base_joints = self.config.base.planar_joints
+            self.body_io = MujocoRobotIO(sim, self.config.actuated_joints)
+            self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)  # skills see its BaseMotion
+            self.joints = JointReferenceController(self.body_io, self.config)
         self.grippers = GripperController(self.joints, self.config.grippers)
         io = self.body_io
         ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
-        self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
-        self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, base_joints)
+        #: whole-body motions (reaching, gaze) over a planar base; a walking robot has none yet (docs/walking.md)
+        self.whole_body: WholeBodyController | None = None
+        self.feedforward: BaseAccelerationFeedforward | None = None
+        if isinstance(self.base, BaseDriver):
+            self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
+            self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, self.config.base.planar_joints)
         self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
         self.separation: Separation | None = None  # set with monitor_separation()
         self.control_period = 0.01  # s between step() calls; the executor sets it
@@ -57,7 +74,8 @@ class RobotController:
     def set_control_period(self, period: float) -> None:
         """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""
         self.control_period = period
-        self.whole_body.dt = period
+        if self.whole_body is not None:
+            self.whole_body.dt = period
 
     def monitor_separation(self, separation: Separation) -> None:
         """Slow the base near people and things it senses (``separation.share`` limits every base motion)."""
@@ -70,19 +88,35 @@ class RobotController:
             self.separation.update(base_pose[:2])
         for planner in self.planners:
             planner.step()
-        self.whole_body.step()  # streams references first, the controllers below then track them
+        if self.whole_body is not None:
+            self.whole_body.step()  # streams references first, the controllers below then track them
         self.base.step()
-        self.joints.feedforward = self.feedforward.update(base_pose, self.body_io.positions(), self.base.acceleration)
+        if self.feedforward is not None:
+            acceleration = self.base.acceleration  # type: ignore[attr-defined]
+            self.joints.feedforward = self.feedforward.update(base_pose, self.body_io.positions(), acceleration)
         self.joints.step()
+        if self.walking is not None:  # the upper body's references become the balance QP's posture targets
+            joints, upper = self.joints, self._upper_body
+            self.walking.walker.upper_body.set_target(
+                joints.position[upper], joints.velocity[upper], joints.acceleration[upper]
+            )
         self.grippers.step()
 
     def brake(self) -> None:
         """Halt every motion: base and joints decelerate to rest under their limits."""
         for planner in self.planners:
             planner.halt()
-        self.whole_body.cancel()
+        if self.whole_body is not None:
+            self.whole_body.cancel()
         self.base.brake()
         self.joints.brake()
+
+    def hand_position(self, side: str) -> np.ndarray:
+        """Where the ``side`` gripper's grip point is (world), from the encoders and odometry."""
+        if self.whole_body is not None:
+            return self.whole_body.frame_pose(self.whole_body.hand_frame(side)).translation.copy()
+        assert self.walking is not None
+        return self.walking.walker.dynamics.pose(self.config.grippers[side].grip_site).translation.copy()
 
     def joint_positions(self) -> dict[str, float]:
         return dict(zip(self.body_io.joints, self.body_io.positions().tolist(), strict=False))

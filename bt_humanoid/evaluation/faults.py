@@ -257,7 +257,7 @@ class Push(Injector):
     def __init__(self, run: MissionRun, settings: PushSettings, sign: float) -> None:
         super().__init__(run)
         self.settings, self.sign = settings, sign
-        self.base = run.sim.model.body("base").id
+        self.base = run.sim.model.body(run.sim.robot_root).id
         self.released = False
 
     def watch(self) -> None:

@@ -73,8 +73,11 @@ class MissionLoader:
         check_world: bool = True,
         subtree_roots: Sequence[Path] | None = None,
         scene: str | SceneConfig | None = None,
+        robot: str | None = None,
     ) -> None:
         self.library = library or BehaviorLibrary()
+        # the robot given on the command line (--robot), over the mission's: the mission is checked against it
+        self.robot = robot
         # the scene given on the command line (a name, or a path from the working directory), over the mission's
         self.scene = scene
         # False when checking a behaviour on its own: its arguments are placeholders then
@@ -112,6 +115,8 @@ class MissionLoader:
             header = MissionHeader.model_validate(header_data)
         except ValidationError as error:
             raise source.invalid(error, ()) from None
+        if self.robot is not None:
+            header = header.model_copy(update={"robot": self.robot})
         robot = _config_at(load_robot_config, header.robot, source, "robot")
         world = _config_at(load_world_config, header.world, source, "world")
         self.checks = CheckContext(robot, world, joint_ranges(robot))

@@ -57,7 +57,7 @@ class Navigator:
         self.sim, self.bounds = sim, bounds
         self.remap()
         camera = next(iter(config.cameras), None)
-        self.camera = DepthCamera(sim.model, sim.data, camera, "base") if camera else None
+        self.camera = DepthCamera(sim.model, sim.data, camera, sim.robot_root) if camera else None
         self.camera_frame = config.frames[camera][1] if camera in config.frames else None
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
         self.last_scan = -math.inf

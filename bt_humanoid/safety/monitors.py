@@ -188,9 +188,8 @@ class WorkspaceMonitor:
         x, y, _ = self.robot.base.pose()
         if not (np.all([x, y] >= self.low) and np.all([x, y] <= self.high)):
             return f"the base at ({x:.2f}, {y:.2f}) left the map ({self.low.tolist()} to {self.high.tolist()})"
-        whole_body = self.robot.whole_body
         for side in self.robot.config.grippers:
-            z = float(whole_body.frame_pose(whole_body.hand_frame(side)).translation[2])
+            z = float(self.robot.hand_position(side)[2])
             if z < self.min_hand_height:
                 return (
                     f"the {side} hand is {z * 100:.0f} cm above the floor (lowest allowed {self.min_hand_height:g} m)"

@@ -49,7 +49,10 @@ class GroundTruth:
         return self.data.xpos[self.model.body(body).id].copy()
 
     def robot_pose(self) -> tuple[float, float, float]:
-        """(x, y, yaw in radians) of the base."""
+        """(x, y, yaw in radians) of the base (a legged robot's: its pelvis)."""
+        if self.sim.robot.base.floating:
+            position, rotation, _, _ = self.floating_base()
+            return float(position[0]), float(position[1]), math.atan2(rotation[1, 0], rotation[0, 0])
         joints = self.sim.robot.base.joints
         qpos = self.data.qpos
         return tuple(float(qpos[self.model.joint(joints[a]).qposadr[0]]) for a in ("x", "y", "yaw"))  # type: ignore[return-value]

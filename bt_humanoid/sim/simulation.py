@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 
 # Off-screen rendering without a display needs EGL; set before mujoco loads.
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -57,6 +58,10 @@ class Simulation:
         root = int(self.model.body_rootid[self.model.joint(robot.base.root_joint).bodyid[0]])
         #: every body of the robot: the tree under the body its base joints move
         self.robot_bodies = {b for b in range(self.model.nbody) if self.model.body_rootid[b] == root}
+        self.robot_root = self.model.body(root).name  # that body's name ("base" on wheels, "pelvis" on legs)
+        #: called before every physics step: controllers that must run at the physics rate (a biped's balance
+        #: controller: its legs are torque-controlled, and a torque holds only until the next command)
+        self.physics_controllers: list[Callable[[], None]] = []
         self.walkers = [
             WalkerDriver(self.model, self.data, name, walker, root, self.robot_bodies)
             for name, walker in world.walkers.items()
@@ -177,7 +182,13 @@ class Simulation:
     def step(self, n: int = 1) -> None:
         for walker in self.walkers:  # the scene's people act at the caller's rate (the control period)
             walker.control()
-        mujoco.mj_step(self.model, self.data, nstep=n)
+        if not self.physics_controllers:
+            mujoco.mj_step(self.model, self.data, nstep=n)
+            return
+        for _ in range(n):  # a legged robot's balance runs every physics step, inside the caller's period
+            for control in self.physics_controllers:
+                control()
+            mujoco.mj_step(self.model, self.data)
 
     def actuator_for_joint(self, joint: str) -> int:
         """Index of the actuator that drives ``joint``."""

@@ -113,7 +113,7 @@ class ViewMaker:
         self.camera = RgbdCamera(sim, camera, config_camera.width, config_camera.height)
         self._segmentation = mujoco.Renderer(model, config_camera.height, config_camera.width)
         self._segmentation.enable_segmentation_rendering()
-        root = model.body("base").id
+        root = model.body(sim.robot_root).id
         self._robot_geoms = np.array([model.body_rootid[model.geom_bodyid[g]] == root for g in range(model.ngeom)])
         #: per geom: the index of the instance it belongs to, -1 for anything else
         self._instance_of_geom = np.full(model.ngeom, -1)

@@ -139,6 +139,13 @@ class BalanceController:
 
     def step(self) -> None:
         """Read the sensors, estimate, solve the QP, command the actuators."""
+        positions, velocities = self.observe()
+        self._balance()
+        self._command(positions, velocities)
+
+    def observe(self) -> tuple[np.ndarray, np.ndarray]:
+        """Read the sensors and update the state estimate and the model there (no command); the joints' positions
+        and velocities read."""
         io = self.io
         positions, velocities = io.positions().copy(), io.velocities().copy()
         imu = self.config.imu
@@ -153,7 +160,10 @@ class BalanceController:
             state.position, state.rotation, state.linear_velocity, state.angular_velocity, positions, velocities
         )
         self.dynamics.update(q, v)
-        self._balance()
+        return positions, velocities
+
+    def _command(self, positions: np.ndarray, velocities: np.ndarray) -> None:
+        io = self.io
         solution = solve_id(self.dynamics, self.contacts, self.tasks, self.bounds, self.torque_limit, self.dt)
         self.solve_times.append(solution.solve_time)
         self.conic_times.append(solution.conic_time)

@@ -46,6 +46,8 @@ RECOVERY_LIMITS = StepLimits(forward=(-0.25, 0.35), sideways=(0.14, 0.40), yaw=(
 MIN_SWING = 0.3  # s: the shortest a swing may be made to land a pushed robot's foot sooner
 TIMING_CANDIDATES = 8  # landing times tried, from the nominal one to the soonest
 REACH_TOLERANCE = 0.01  # m: a footstep this near to the one wanted is as good
+GOAL_TOLERANCE = 0.01  # m: a body this near its goal has arrived, and steps no more
+GOAL_YAW_TOLERANCE = 0.01  # rad
 STILL = 1e-3  # a command below this (m/s, rad/s) is no command
 
 
@@ -81,9 +83,12 @@ class WalkingController(BalanceController):
         self.swing: SwingTrajectory | None = None
         self.plan: DcmPlan | None = None
         self.time = 0.0
+        self.goal: np.ndarray | None = None  # a body pose to walk to (walk_to), instead of a velocity
+        self.goal_speeds = (0.0, 0.0)
         self._nominal_step: Footstep | None = None  # the swinging foot's planned footstep, before adjustment
         self._touchdown_dcm = np.zeros(2)
         self.dcm_error = 0.0  # m between the DCM and the plan's, last computed in single support
+        self.trace: list | None = None
         self.touchdowns: list[Footstep] = []  # every footstep taken, where the sole was at touchdown
 
     # --- the interface -------------------------------------------------------------------------------------------
@@ -91,10 +96,25 @@ class WalkingController(BalanceController):
     def command(self, vx: float, vy: float = 0.0, wz: float = 0.0) -> None:
         """Walk at this body velocity (m/s forward, m/s leftward, rad/s turning left) from the next footstep."""
         self.velocity = np.array([vx, vy, wz], dtype=float)
+        self.goal = None
+
+    def walk_to(self, x: float, y: float, yaw: float, max_speed: float, max_yaw_rate: float) -> None:
+        """Walk until the middle of the feet stands at (x, y) facing ``yaw`` (world frame; within a centimetre
+        and 0.6°), at most ``max_speed`` m/s and ``max_yaw_rate`` rad/s; then stand."""
+        self.goal = np.array([x, y, yaw], dtype=float)
+        self.goal_speeds = (max_speed, max_yaw_rate)
 
     def brake(self) -> None:
         """Stop walking: the swinging foot lands, one more step brings the feet together, and the robot stands."""
         self.velocity = np.zeros(3)
+        self.goal = None
+
+    def body(self) -> Footstep:
+        """Where the feet put the body: the middle between them, facing half-way between their headings."""
+        assert self.feet is not None
+        left, right = self.feet
+        middle = self._middle()
+        return Footstep(LEFT, float(middle[0]), float(middle[1]), self._mean_yaw(left.yaw, right.yaw))
 
     @property
     def walking(self) -> bool:
@@ -103,7 +123,7 @@ class WalkingController(BalanceController):
     # --- the control step ---------------------------------------------------------------------------------------
 
     def _balance(self) -> None:
-        self.time += self.dt
+        self.time = self.io.time
         if self.feet is None:
             self.feet = [self._measured(side) for side in (LEFT, RIGHT)]
         self._advance()
@@ -122,9 +142,8 @@ class WalkingController(BalanceController):
     def _advance(self) -> None:
         """Move to the next phase when this one is over; keep the swinging foot's task on its path."""
         now = self.time
-        moving = bool(np.any(np.abs(self.velocity) > STILL))
         if self.phase is Phase.STANDING:
-            if moving:
+            if self._moving(self._planning_velocity(self.body())):
                 self._start_walking(now)
         elif self.phase is Phase.DOUBLE and now >= self.phase_end:
             if self.steps:
@@ -138,10 +157,10 @@ class WalkingController(BalanceController):
     def _start_walking(self, now: float) -> None:
         assert self.feet is not None
         # the first step swings the foot on the side the robot is going (left for a left turn or sidestep)
-        _, vy, wz = self.velocity
+        _, vy, wz = self._planning_velocity(self.body())
         first = LEFT if (wz > STILL or (abs(wz) <= STILL and vy > STILL)) else RIGHT
         stance = self.feet[1 - first]
-        self.steps = self.planner.plan(stance, self.velocity, PLANNED_STEPS)
+        self.steps = self.planner.plan(stance, self._planning_velocity(self.planner.body(stance)), PLANNED_STEPS)
         self._double_support(now, START_SHIFT, self._middle())
 
     def _double_support(self, now: float, duration: float, zmp_from: np.ndarray) -> None:
@@ -168,9 +187,12 @@ class WalkingController(BalanceController):
         landed = self._measured(step.side)
         self.feet[step.side] = landed
         self.touchdowns.append(landed)
+        if self.trace is not None:
+            self.trace.append((now, landed, self.goal))
         self.swing = None
-        if np.any(np.abs(self.velocity) > STILL):
-            self.steps = self.planner.plan(landed, self.velocity, PLANNED_STEPS)
+        velocity = self._planning_velocity(self.planner.body(landed))
+        if self._moving(velocity):
+            self.steps = self.planner.plan(landed, velocity, PLANNED_STEPS)
         elif self.planner.together(self.feet[LEFT], self.feet[RIGHT]):
             self.steps = []
         else:
@@ -280,6 +302,33 @@ class WalkingController(BalanceController):
             self.phase_end = now + duration
             self.swing.retarget(elapsed, np.array([target.x, target.y, target.yaw]), elapsed + duration)
 
+    def _planning_velocity(self, body: Footstep) -> np.ndarray:
+        """The body velocity the next footsteps are planned for, from a body at ``body``: the command, or what
+        takes the body to the goal. Towards a goal one step moves the body forward by v T and a pair of steps
+        sideways and round by 2 v T (``FootstepPlanner``), so the velocity that lands on the goal is the
+        distance over one period forward and over two sideways and round, within the goal's speeds."""
+        if self.goal is None:
+            return self.velocity
+        dx, dy, dyaw = Footstep(LEFT, *self.goal).relative_to(body)
+        if abs(dx) < GOAL_TOLERANCE and abs(dy) < GOAL_TOLERANCE and abs(dyaw) < GOAL_YAW_TOLERANCE:
+            return np.zeros(3)
+        period = self.planner.period
+        velocity = np.array([dx / period, dy / (2 * period), dyaw / (2 * period)])
+        max_speed, max_yaw_rate = self.goal_speeds
+        speed = float(np.hypot(velocity[0], velocity[1]))
+        if speed > max_speed:
+            velocity[:2] *= max_speed / speed
+        velocity[2] = float(np.clip(velocity[2], -max_yaw_rate, max_yaw_rate))
+        return velocity
+
+    @staticmethod
+    def _moving(velocity: np.ndarray) -> bool:
+        return bool(np.any(np.abs(velocity) > STILL))
+
+    @staticmethod
+    def _mean_yaw(a: float, b: float) -> float:
+        return b + math.remainder(a - b, 2 * math.pi) / 2
+
     def _heading(self) -> float:
         """The pelvis's yaw: half-way between the feet, the swinging one where its path has it now."""
         assert self.feet is not None
@@ -287,7 +336,7 @@ class WalkingController(BalanceController):
         if self.phase is Phase.SINGLE and self.swing is not None:
             side = self.steps[0].side
             yaws[side] = float(self.swing.at(self.time - self.phase_start)[0][3])
-        return yaws[RIGHT] + math.remainder(yaws[LEFT] - yaws[RIGHT], 2 * math.pi) / 2
+        return self._mean_yaw(yaws[LEFT], yaws[RIGHT])
 
     def _middle(self) -> np.ndarray:
         assert self.feet is not None
