@@ -25,7 +25,6 @@ from bt_humanoid.sim.robot_config import BaseConfig
 
 LATERAL_ACCEL = 0.4  # m/s^2 allowed sideways in a bend: v ≤ sqrt(a / curvature)
 FINAL_STRETCH = 0.4  # m before the goal from which the base turns to the goal's yaw
-BLOCKED_ERROR = 0.25  # m behind the reference: something holds the base back
 SETTLE_TIMEOUT = 3.0  # s at the end of the route to come within tolerance
 END_EPSILON = 1e-3  # m of the route's end that counts as reached
 STOP_SHORT = 0.3  # m the base stops short of where its route is blocked
@@ -105,8 +104,10 @@ class RouteFollower:
             self.stop()
             return
         speed_cap = min(self._speed_cap(route, s, float(inp.current_velocity[0])), share * self.max_speed)
-        inp.max_velocity = [max(speed_cap, 1e-3), max(share * limits.max_yaw_rate, 1e-3)]
         yaw = self._heading_target(route, s, index)
+        if limits.turn_first is not None and abs(wrap_angle(yaw - self.base.pose()[2])) > limits.turn_first:
+            speed_cap = 0.0  # face the way first: the route's reference waits while the base turns
+        inp.max_velocity = [max(speed_cap, 1e-3), max(share * limits.max_yaw_rate, 1e-3)]
         end = route.length if self.stop_at is None else min(route.length, max(s, self.stop_at - STOP_SHORT))
         # while held to a crawl (someone close), a far end would take longer than a trajectory can last: aim no
         # further than the crawl covers in HORIZON seconds, beyond the braking distance (re-aimed every step)
@@ -163,7 +164,7 @@ class RouteFollower:
     def _check(self, route: Route, handle: MotionHandle, reference: np.ndarray, s: float, speed: float) -> None:
         pose = self.base.pose()
         lag = float(np.hypot(*(reference[:2] - pose[:2])))
-        if lag > BLOCKED_ERROR:
+        if lag > self.config.tolerance.tracking:  # something holds the base back
             handle.fail(f"base blocked near ({pose[0]:.2f}, {pose[1]:.2f}): {lag:.2f} m behind its route")
             self.handle = None
             self.stop()
@@ -183,7 +184,9 @@ class RouteFollower:
             return
         now = self.base.time
         self.started_settling = self.started_settling if self.started_settling is not None else now
-        if now - self.started_settling > SETTLE_TIMEOUT:
+        # a slow base (a biped turning at 0.3 rad/s, a step at a time) gets the time its last turn takes as well
+        settle = SETTLE_TIMEOUT + abs(wrap_angle(route.goal_yaw - pose[2])) / self.config.limits.max_yaw_rate
+        if now - self.started_settling > settle:
             handle.fail(f"stopped {remaining:.2f} m and {math.degrees(yaw_error):.0f}° from the goal")
             self.handle = None
             self.stop()

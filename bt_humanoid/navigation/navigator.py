@@ -286,9 +286,8 @@ class Navigator:
         base = self.robot.base.pose()[:2]
         hits = scan.hits
         mine = np.hypot(*(hits[:, :2] - base).T) < self.robot.config.base.footprint_radius + OWN_MARGIN
-        whole_body = self.robot.whole_body
         for side in self.robot.config.grippers:  # what a hand holds hangs below it: not an obstacle
-            hand = whole_body.frame_pose(whole_body.hand_frame(side)).translation
+            hand = self.robot.hand_position(side)
             mine |= (np.hypot(*(hits[:, :2] - hand[:2]).T) < HELD_RADIUS) & (hits[:, 2] < hand[2] + 0.05)
         keep = ~mine & (hits[:, 2] > OBSTACLE_MIN_HEIGHT) & (hits[:, 2] < ROBOT_HEIGHT)
         rows, cols = self.grid.cell(hits[:, :2])

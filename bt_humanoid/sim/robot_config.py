@@ -25,11 +25,16 @@ class BaseLimits(StrictModel):
     max_yaw_rate: float = 1.2
     max_yaw_accel: float = 2.0
     max_yaw_jerk: float = 8.0
+    #: rad of heading error beyond which the base turns towards its route before it moves along it; None: it
+    #: turns while it moves (a wheeled base; a biped walks three times faster forwards than sideways)
+    turn_first: float | None = None
 
 
 class BaseTolerance(StrictModel):
     position: float = 0.02
     yaw_deg: float = 2.0
+    #: m a base may fall behind a streamed route before it counts as blocked (a walking base answers a step late)
+    tracking: float = 0.25
 
 
 PLANAR_AXES = ("x", "y", "yaw")

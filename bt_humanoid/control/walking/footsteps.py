@@ -55,13 +55,20 @@ class StepLimits:
     forward: tuple[float, float] = (-0.15, 0.25)  # m
     sideways: tuple[float, float] = (0.14, 0.30)  # m
     yaw: tuple[float, float] = (-0.1, 0.4)  # rad
+    #: m of extra sideways distance per radian the feet are turned apart: a turned sole sweeps its heel (or toe)
+    #: inwards by about half its length times the angle, towards the other foot
+    turned_clearance: float = 0.11
+
+    def narrowest(self, dyaw: float) -> float:
+        """The least sideways distance between the soles' centres when they are turned ``dyaw`` apart."""
+        return self.sideways[0] + self.turned_clearance * abs(dyaw)
 
     def clip(self, step: Footstep, stance: Footstep) -> Footstep:
         dx, dy, dyaw = step.relative_to(stance)
         sign = SIDE_SIGN[step.side]
         dx = float(np.clip(dx, *self.forward))
-        dy = sign * float(np.clip(sign * dy, *self.sideways))
         dyaw = sign * float(np.clip(sign * dyaw, *self.yaw))
+        dy = sign * float(np.clip(sign * dy, self.narrowest(dyaw), self.sideways[1]))
         return stance.moved(dx, dy, dyaw, step.side)
 
     def contains(self, step: Footstep, stance: Footstep, tolerance: float = 1e-9) -> bool:
@@ -69,7 +76,7 @@ class StepLimits:
         sign = SIDE_SIGN[step.side]
         return (
             self.forward[0] - tolerance <= dx <= self.forward[1] + tolerance
-            and self.sideways[0] - tolerance <= sign * dy <= self.sideways[1] + tolerance
+            and self.narrowest(dyaw) - tolerance <= sign * dy <= self.sideways[1] + tolerance
             and self.yaw[0] - tolerance <= sign * dyaw <= self.yaw[1] + tolerance
         )
 

@@ -30,7 +30,7 @@ from bt_humanoid.sim.simulation import Simulation
 
 SINGLE_SUPPORT = 0.6  # s with one foot in the air
 DOUBLE_SUPPORT = 0.1  # s passing the weight from foot to foot
-START_SHIFT = 0.6  # s moving the weight onto the first stance foot before the first step
+START_SHIFT = 0.4  # s moving the weight onto the first stance foot before the first step
 END_SHIFT = 0.4  # s moving it back to the middle of the feet after the last
 STEP_HEIGHT = 0.05  # m the swinging foot clears the floor
 PLANNED_STEPS = 3  # footsteps planned ahead: the DCM plan's horizon (2.1 s, e^{−ωT} ≈ 4e-4)
@@ -39,8 +39,9 @@ PLANNED_STEPS = 3  # footsteps planned ahead: the DCM plan's horizon (2.1 s, e^{
 WALKING_DCM_GAIN = 6.0
 SWING_WEIGHT = 30.0
 SWING_GAINS = (400.0, 40.0)  # K_p (1/s²), K_d (1/s): the swing foot follows its path within millimetres
-# m of DCM error that the ankles take and the footstep ignores; beyond it the footstep moves (_adjust_step)
-ADJUSTMENT_DEADBAND = 0.04
+# share of the stance sole's reach of the centre of pressure that the ankles are counted on for; a DCM error
+# beyond it moves the footstep (_adjust_step)
+ROOM_SHARE = 0.8
 # where a footstep may go to recover from a push: further than walking's steps, as far as the legs reach
 RECOVERY_LIMITS = StepLimits(forward=(-0.25, 0.35), sideways=(0.14, 0.40), yaw=(-0.1, 0.4))
 MIN_SWING = 0.3  # s: the shortest a swing may be made to land a pushed robot's foot sooner
@@ -263,12 +264,13 @@ class WalkingController(BalanceController):
         """Move the swinging foot's footstep, and land it sooner, where it captures the DCM (docs/walking.md,
         step adjustment; after Khadiv et al., "Walking control based on step timing adaptation", 2020).
 
-        Held on the stance sole's centre p, the DCM moves as ξ(t) = p + (ξ − p) e^{ω t}: by a touchdown τ s from
-        now it is at ξ_τ, and a footstep at ξ_τ − b, b the plan's DCM offset from the footstep at touchdown,
-        carries on as planned from there. The nominal landing time is kept while its footstep is within what
-        the legs can reach (``RECOVERY_LIMITS``); otherwise the foot lands sooner, as soon as the swing allows
-        (``MIN_SWING``), where the DCM has gone less far. Errors the ankles can take (``ADJUSTMENT_DEADBAND``)
-        move nothing; once the foot is coming down, nothing changes.
+        While the DCM error e = ξ − ξ_ref is within what the stance sole's centre of pressure can answer (its
+        ``room`` that way), the balance law's ankle torque makes it decay and the footstep stays. Beyond, the
+        centre of pressure stops at the sole's edge, p = pivot + room ê, and the DCM runs away as
+        ξ(τ) = p + (ξ − p) e^{ω τ}: the footstep moves by what that adds to the plan's DCM at touchdown, less the
+        room the new sole will have. The nominal landing time is kept while that footstep is within what the
+        legs can reach (``RECOVERY_LIMITS``); otherwise the foot lands sooner, as soon as the swing allows
+        (``MIN_SWING``), where the DCM has gone less far. Once the foot is coming down, nothing changes.
         """
         elapsed, remaining = now - self.phase_start, self.phase_end - now
         if self.plan is None or self.feet is None or remaining < LIFT_SHARE * SINGLE_SUPPORT:
@@ -277,18 +279,20 @@ class WalkingController(BalanceController):
         assert self.swing is not None and nominal is not None
         stance = self.feet[1 - nominal.side]
         _, dcm_reference, _ = self.plan.at(now)
-        self.dcm_error = float(np.linalg.norm(self.dcm() - dcm_reference))
-        if self.dcm_error <= ADJUSTMENT_DEADBAND:
+        dcm = self.dcm()
+        error = dcm - dcm_reference
+        self.dcm_error = size = float(np.linalg.norm(error))
+        direction = error / max(size, 1e-9)
+        room = self._room(stance, direction)
+        if size <= room:
             return
-        pivot, dcm = stance.position, self.dcm()
-        offset = self._touchdown_dcm - nominal.position  # b
+        pivot = stance.position + room * direction  # the centre of pressure, at the sole's edge
+        offset = self._touchdown_dcm - nominal.position  # the plan's DCM from the footstep at touchdown
         shortest = max(MIN_SWING - elapsed, LIFT_SHARE * SINGLE_SUPPORT)
         best: tuple[float, float, Footstep] | None = None
         for duration in np.linspace(remaining, min(shortest, remaining), TIMING_CANDIDATES):
-            needed = pivot + (dcm - pivot) * math.exp(self.omega * duration) - offset
-            shift = needed - nominal.position  # less the deadband, which the ankles take
-            shift *= max(1.0 - ADJUSTMENT_DEADBAND / max(float(np.linalg.norm(shift)), 1e-9), 0.0)
-            wanted = Footstep(nominal.side, nominal.x + shift[0], nominal.y + shift[1], nominal.yaw)
+            needed = pivot + (dcm - pivot) * math.exp(self.omega * duration) - offset - room * direction
+            wanted = Footstep(nominal.side, float(needed[0]), float(needed[1]), nominal.yaw)
             target = RECOVERY_LIMITS.clip(wanted, stance)
             miss = float(np.linalg.norm(target.position - wanted.position))
             if best is None or miss < best[0] - REACH_TOLERANCE:
@@ -301,6 +305,15 @@ class WalkingController(BalanceController):
             self.steps[0] = target
             self.phase_end = now + duration
             self.swing.retarget(elapsed, np.array([target.x, target.y, target.yaw]), elapsed + duration)
+
+    def _room(self, stance: Footstep, direction: np.ndarray) -> float:
+        """How far the centre of pressure may go from the stance sole's centre towards ``direction`` (world, unit):
+        to the edge of the sole's rectangle, less the cone's margin, times ``ROOM_SHARE``."""
+        c, s = math.cos(stance.yaw), math.sin(stance.yaw)
+        along, across = abs(c * direction[0] + s * direction[1]), abs(-s * direction[0] + c * direction[1])
+        contact = self.contacts[stance.side]
+        half_length, half_width = contact.length / 2 - contact.cop_margin, contact.width / 2 - contact.cop_margin
+        return ROOM_SHARE * min(half_length / max(along, 1e-9), half_width / max(across, 1e-9))
 
     def _planning_velocity(self, body: Footstep) -> np.ndarray:
         """The body velocity the next footsteps are planned for, from a body at ``body``: the command, or what

@@ -31,7 +31,10 @@ from bt_humanoid.sim.standing import standing_posture
 POSITION_GAIN = 1.0  # 1/s: body velocity per metre (radian) of error from a streamed reference
 LARGEST_TURN = math.pi / 2  # rad of a long turn fed to the walker at once (its goals wrap at half a circle)
 FINAL_STRETCH = 0.5  # m from a pose goal within which the robot turns to the goal's heading; before, to the goal
-GOAL_TIMEOUT = 10.0  # s beyond the time a pose goal should take at the allowed speeds before it fails
+GOAL_TIMEOUT = 10.0
+# m/s a streamed reference may ask sideways: about what a pair of sidesteps covers (0.12 m in 1.4 s); more turns
+# into steps at the edges of what the legs reach while they walk forwards and turn as well
+SIDEWAYS_SPEED = 0.08  # s beyond the time a pose goal should take at the allowed speeds before it fails
 
 
 def wrap(angle: float) -> float:
@@ -183,5 +186,6 @@ class WalkingBase(SpeedMonitoring):
         speed = float(np.hypot(body[0], body[1]))
         if speed > self.capped():
             body[:2] *= self.capped() / speed
+        body[1] = float(np.clip(body[1], -SIDEWAYS_SPEED, SIDEWAYS_SPEED))
         body[2] = float(np.clip(body[2], -limits.max_yaw_rate, limits.max_yaw_rate))
         self.walker.command(*body)
