@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -42,14 +43,14 @@ def body_of(planner: FootstepPlanner, steps: list[Footstep]) -> Footstep:
 def test_a_velocity_gives_alternating_steps_that_cover_its_distance(planner, velocity, expected):
     steps = walk(planner, velocity, 10)
     assert [s.side for s in steps] == [LEFT, RIGHT] * 5 + [LEFT]
-    assert all(StepLimits().contains(b, a) for a, b in zip(steps, steps[1:], strict=False))
+    assert all(StepLimits().contains(b, a) for a, b in itertools.pairwise(steps))
     body = body_of(planner, steps)
     assert (body.x, body.y) == pytest.approx(expected, abs=1e-6)
 
 
 def test_a_command_beyond_the_legs_reach_gives_the_largest_steps(planner):
     steps = walk(planner, (2.0, 0.0, 0.0), 4)
-    forward = [b.relative_to(a)[0] for a, b in zip(steps, steps[1:], strict=False)]
+    forward = [b.relative_to(a)[0] for a, b in itertools.pairwise(steps)]
     assert forward == pytest.approx([StepLimits().forward[1]] * 4)
 
 
@@ -62,7 +63,7 @@ def test_turning_in_place_360_degrees_opens_and_closes_the_feet_without_crossing
         steps.append(step)
         assert len(steps) < 40
     assert len(steps) - 1 <= 34  # 0.4 rad per pair: 16 pairs, and the last
-    for a, b in zip(steps, steps[1:], strict=False):
+    for a, b in itertools.pairwise(steps):
         assert StepLimits().contains(b, a)
         assert math.hypot(b.x - a.x, b.y - a.y) < 0.25  # in place: the feet stay round the same spot
 
@@ -133,7 +134,7 @@ def test_a_dcm_plan_needs_matching_knots():
 def test_the_swing_lifts_clears_and_lands_at_rest_on_its_footstep():
     start, end = np.array([0.0, 0.1, 0.0, 0.0]), np.array([0.25, 0.12, 0.0, 0.3])
     swing = SwingTrajectory(start, end, 0.6, height=0.05)
-    pose, velocity, acceleration = swing.at(0.0)
+    pose, velocity, _acceleration = swing.at(0.0)
     assert pose == pytest.approx(start) and velocity == pytest.approx(np.zeros(4))
     pose, velocity, _ = swing.at(0.6)
     assert pose == pytest.approx([0.25, 0.12, -PRESS, 0.3]) and velocity == pytest.approx(np.zeros(4), abs=1e-9)
