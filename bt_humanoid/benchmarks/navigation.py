@@ -1,6 +1,7 @@
 """Navigation benchmark: random start poses to every named goal of the apartment.
 
     python -m bt_humanoid.benchmarks.navigation --starts 20
+    python -m bt_humanoid.benchmarks.navigation --starts 20 --robot biped_humanoid   # walking
 
 Each start is a random free pose (clearance for the base, random heading);
 each run is the `navigate` behaviour (replanning and recovery included) from
@@ -11,6 +12,10 @@ at every control step. Prints success, errors, contacts, average speed while
 driving, planning time (median, p95) and route length relative to a grid-A*
 route on the same map. Runs pinned to one CPU core; ``--json PATH`` also
 writes the figures.
+
+``--robot biped_humanoid`` walks the same runs: judged within 10 cm and 10° (its goals are footsteps), its
+soles' contacts with the floor are not counted as contacts, and falls are counted (the pelvis below 0.35 m,
+or anything but a sole touching the floor).
 """
 
 from __future__ import annotations
@@ -30,9 +35,10 @@ from bt_humanoid.testing.scenario import build_run
 
 GOALS = ("table", "counter", "shelf", "kitchen", "living_room")
 START_CLEARANCE = 0.8  # m of free floor around a random start: the arms of the home posture reach 0.7 m
-POSITION_TOLERANCE = 0.05  # m
-HEADING_TOLERANCE = 5.0  # degrees
-SPEED = 0.8  # m/s cap for the drive
+#: m and degrees a run must end within, per robot (a biped's goals are footsteps: issue 24 asks for 10 cm, 10°)
+TOLERANCES = {"wheeled_humanoid": (0.05, 5.0), "biped_humanoid": (0.10, 10.0)}
+SPEED = 0.8  # m/s cap for the drive (the biped's base limits it to 0.35)
+FALLEN_HEIGHT = 0.35  # m: a legged robot's pelvis below this has fallen
 MOVING = 0.02  # m/s: the base counts as driving above this speed
 
 
@@ -49,6 +55,7 @@ class Outcome:
     planning_times: list[float]
     route_ratio: float | None
     failure: str | None
+    fell: bool = False
 
 
 def random_starts(count: int, rng: np.random.Generator, world: str = "apartment") -> list[tuple[float, float, float]]:
@@ -78,18 +85,28 @@ def _clear_of_walkers(xy: np.ndarray, world) -> bool:
     return True
 
 
-def run_one(start: tuple[float, float, float], goal: str, world: str = "apartment") -> Outcome:
+def run_one(
+    start: tuple[float, float, float], goal: str, world: str = "apartment", robot: str = "wheeled_humanoid"
+) -> Outcome:
     mission = {
         "mission": f"navigate to the {goal}",
         "world": world,
+        "robot": robot,
         "tree": {"navigate": {"place": goal, "speed": SPEED}},
     }
     run = build_run(mission, robot_start=start)
     contacts: list[tuple[str, str]] = []
     track: list[tuple[float, np.ndarray, float]] = []
+    floating = run.sim.robot.base.floating
+    fell = False
 
     def observe() -> None:
-        contacts.extend(run.truth.robot_contacts())
+        nonlocal fell
+        touching = run.truth.robot_contacts()
+        if floating:  # a biped stands on its soles: those contacts with the floor are its footing
+            touching = [(mine, other) for mine, other in touching if not ("_sole_" in mine and other == "floor")]
+            fell = fell or run.truth.floating_base()[0][2] < FALLEN_HEIGHT or any(o == "floor" for _, o in touching)
+        contacts.extend(touching)
         x, y, _ = run.truth.robot_pose()
         track.append((run.sim.time, np.array([x, y]), float(np.hypot(*run.robot.base.speeds()[:2]))))
 
@@ -108,10 +125,16 @@ def run_one(start: tuple[float, float, float], goal: str, world: str = "apartmen
         navigator.grid, np.array(start[:2]), np.array([gx, gy]), navigator.clearance.preferred
     )
     route_ratio = navigator.route_lengths[0] / reference if reference and navigator.route_lengths else None
+    position_tolerance, heading_tolerance = TOLERANCES.get(robot, TOLERANCES["wheeled_humanoid"])
     success = (
-        result.tree_status == "SUCCESS" and position_error <= POSITION_TOLERANCE and heading_error <= HEADING_TOLERANCE
+        result.tree_status == "SUCCESS"
+        and position_error <= position_tolerance
+        and heading_error <= heading_tolerance
+        and not fell
     )
     failure = None if success else (result.cause or f"stopped {position_error * 100:.1f} cm, {heading_error:.1f}° off")
+    if fell:
+        failure = f"fell ({failure})"
     return Outcome(
         start,
         goal,
@@ -124,6 +147,7 @@ def run_one(start: tuple[float, float, float], goal: str, world: str = "apartmen
         list(navigator.planning_times),
         route_ratio,
         failure,
+        fell,
     )
 
 
@@ -133,18 +157,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--world", default="apartment", help="apartment, or apartment_busy (a person walks a loop across the middle)"
     )
+    parser.add_argument("--robot", default="wheeled_humanoid", choices=sorted(TOLERANCES), help="robot that goes")
     args = parse_benchmark_args(parser, argv, "starts")
     started = time.perf_counter()
     starts = random_starts(args.starts, np.random.default_rng(args.seed), args.world)
     total = len(starts) * len(args.goals)
     print(
-        f"bt-humanoid navigation benchmark in {args.world}: {len(starts)} starts × {len(args.goals)} goals, "
-        f"seed {args.seed}"
+        f"bt-humanoid navigation benchmark in {args.world} ({args.robot}): {len(starts)} starts × "
+        f"{len(args.goals)} goals, seed {args.seed}"
     )
     outcomes = []
     for start in starts:
         for goal in args.goals:
-            outcome = run_one(start, goal, args.world)
+            outcome = run_one(start, goal, args.world, args.robot)
             outcomes.append(outcome)
             verdict = "ok" if outcome.success else f"FAILED: {outcome.failure}"
             speed = outcome.distance / outcome.drive_time if outcome.drive_time > 0 else 0.0
@@ -164,6 +189,7 @@ def main(argv: list[str] | None = None) -> int:
         "max_position_error_cm": max(o.position_error for o in successes) * 100 if successes else None,
         "max_heading_error_deg": max(o.heading_error for o in successes) if successes else None,
         "runs_with_contacts": sum(1 for o in outcomes if o.contacts),
+        "falls": sum(1 for o in outcomes if o.fell),
         "average_speed": sum(o.distance for o in outcomes) / drive if drive > 0 else 0.0,
         "planning_median_ms": statistics.median(plans) if plans else None,
         "planning_p95_ms": percentile(plans, 0.95) if plans else None,
@@ -173,13 +199,15 @@ def main(argv: list[str] | None = None) -> int:
         "wall_s": round(time.perf_counter() - started, 1),
     }
     print()
-    print(f"  success {figures['success_rate']:.0%} of {len(outcomes)} runs (target ≥ 98 %)")
+    position_tolerance, heading_tolerance = TOLERANCES[args.robot]
+    print(f"  success {figures['success_rate']:.0%} of {len(outcomes)} runs")
     if successes:
         print(
-            f"  worst final error of the successes: {figures['max_position_error_cm']:.1f} cm (≤ 5 cm), "
-            f"{figures['max_heading_error_deg']:.1f}° (≤ 5°)"
+            f"  worst final error of the successes: {figures['max_position_error_cm']:.1f} cm "
+            f"(≤ {position_tolerance * 100:.0f} cm), "
+            f"{figures['max_heading_error_deg']:.1f}° (≤ {heading_tolerance:.0f}°)"
         )
-    print(f"  runs with a robot contact: {figures['runs_with_contacts']} (target 0)")
+    print(f"  runs with a robot contact: {figures['runs_with_contacts']} (target 0); falls: {figures['falls']}")
     print(f"  average speed while driving: {figures['average_speed']:.2f} m/s (target ≥ 0.4 m/s)")
     if plans:
         median, p95 = figures["planning_median_ms"], figures["planning_p95_ms"]

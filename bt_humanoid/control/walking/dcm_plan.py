@@ -21,7 +21,11 @@ import numpy as np
 class DcmPlan:
     """ZMP and DCM references through the knots (t_i, p_i): p linear between knots, held after the last."""
 
-    def __init__(self, times: list[float], zmps: list[np.ndarray], omega: float) -> None:
+    def __init__(
+        self, times: list[float], zmps: list[np.ndarray], omega: float, start_dcm: np.ndarray | None = None
+    ) -> None:
+        """``start_dcm``: the DCM the plan must start from (a robot standing still, about to walk); the first
+        knot's ZMP is then chosen to give it, instead of the one given."""
         if len(times) != len(zmps) or not times:
             raise ValueError("a DCM plan needs one ZMP per knot time, and at least one")
         if any(b < a for a, b in itertools.pairwise(times)):
@@ -43,6 +47,15 @@ class DcmPlan:
                 + slope / omega
                 + math.exp(-omega * duration) * (dcms[i + 1] - self.zmps[i + 1] - slope / omega)
             )
+        if start_dcm is not None and len(times) > 1 and self.times[1] > self.times[0]:
+            # ξ_0 is affine in p_0 on the first segment: ξ_0 = a p_0 + b, with ωΔ = r and e^{−r} = d,
+            # a = 1 − (1 − d)/r and b = p_1 (1 − d)/r + d (ξ_1 − p_1): solve for the p_0 that starts at start_dcm
+            r = omega * (self.times[1] - self.times[0])
+            d = math.exp(-r)
+            a = 1.0 - (1.0 - d) / r
+            b = self.zmps[1] * (1.0 - d) / r + d * (dcms[1] - self.zmps[1])
+            self.zmps[0] = (np.asarray(start_dcm, dtype=float) - b) / a
+            dcms[0] = np.asarray(start_dcm, dtype=float)
         self.dcms = dcms
 
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -162,13 +162,16 @@ class WalkingController(BalanceController):
         first = LEFT if (wz > STILL or (abs(wz) <= STILL and vy > STILL)) else RIGHT
         stance = self.feet[1 - first]
         self.steps = self.planner.plan(stance, self._planning_velocity(self.planner.body(stance)), PLANNED_STEPS)
-        self._double_support(now, START_SHIFT, self._middle())
+        self._double_support(now, START_SHIFT, self._middle(), start_dcm=self.dcm())
 
-    def _double_support(self, now: float, duration: float, zmp_from: np.ndarray) -> None:
-        """Begin a double support of ``duration`` moving the ZMP from ``zmp_from`` towards the next stance foot."""
+    def _double_support(
+        self, now: float, duration: float, zmp_from: np.ndarray, start_dcm: np.ndarray | None = None
+    ) -> None:
+        """Begin a double support of ``duration`` moving the ZMP from ``zmp_from`` towards the next stance foot
+        (or from where it starts the DCM at ``start_dcm``, a robot setting off)."""
         self.phase = Phase.DOUBLE
         self.phase_start, self.phase_end = now, now + duration
-        self._plan_dcm(now, zmp_from)
+        self._plan_dcm(now, zmp_from, start_dcm)
 
     def _lift(self, now: float) -> None:
         step = self.steps[0]
@@ -211,7 +214,7 @@ class WalkingController(BalanceController):
 
     # --- references -----------------------------------------------------------------------------------------------
 
-    def _plan_dcm(self, now: float, zmp_from: np.ndarray) -> None:
+    def _plan_dcm(self, now: float, zmp_from: np.ndarray, start_dcm: np.ndarray | None = None) -> None:
         """The ZMP knots from now through the planned footsteps to standing, and the DCM through them."""
         assert self.feet is not None
         times, zmps = [now], [np.asarray(zmp_from, dtype=float)]
@@ -229,7 +232,7 @@ class WalkingController(BalanceController):
         else:
             times.append(t)
         zmps.append(middle)
-        self.plan = DcmPlan(times, zmps, self.omega)
+        self.plan = DcmPlan(times, zmps, self.omega, start_dcm)
 
     def _update_contacts(self, now: float) -> None:
         """Which soles stand, how much the leaving one may still carry, and the swinging sole's target."""

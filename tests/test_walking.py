@@ -1,0 +1,140 @@
+"""The biped walks on its own legs in MuJoCo physics: forwards, backwards, sideways, round, stops within two
+steps, walks to pose goals, and runs base-motion missions (docs/walking.md). Judged in ground truth."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bt_humanoid.control.walking.walker import Phase, WalkingController
+from bt_humanoid.control.walking.walking_base import WalkingBase
+from bt_humanoid.sim.ground_truth import GroundTruth
+from bt_humanoid.sim.robot_config import load_robot_config
+from bt_humanoid.sim.scene_config import SceneConfig
+from bt_humanoid.sim.simulation import Simulation
+from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.testing.scenario import run_scenario
+
+pytestmark = pytest.mark.sim
+
+
+def open_floor() -> Simulation:
+    return Simulation(load_world_config("open_floor"), load_robot_config("biped_humanoid"), SceneConfig())
+
+
+def yaw_of(rotation: np.ndarray) -> float:
+    return math.atan2(rotation[1, 0], rotation[0, 0])
+
+
+class Walk:
+    """A walking controller on the open floor, stepped and watched in ground truth."""
+
+    def __init__(self) -> None:
+        self.sim = open_floor()
+        self.truth = GroundTruth(self.sim)
+        self.walker = WalkingController(self.sim)
+        self.start = self.truth.floating_base()[0].copy()
+        self.turned = 0.0  # rad, unwrapped
+        self._yaw = yaw_of(self.truth.floating_base()[1])
+
+    def run(self, seconds: float) -> None:
+        for _ in range(round(seconds / self.sim.timestep)):
+            self.walker.step()
+            self.sim.step()
+            yaw = yaw_of(self.truth.floating_base()[1])
+            self.turned += math.remainder(yaw - self._yaw, 2 * math.pi)
+            self._yaw = yaw
+            feet_only = all("_sole_" in mine for mine, _ in self.truth.robot_contacts())
+            assert feet_only and self.truth.floating_base()[0][2] > 0.4, f"fell at {self.sim.time:.2f} s"
+            # nothing but the actuators moves the robot: no applied forces, no constraints holding it up
+            assert not np.any(self.sim.data.xfrc_applied) and not np.any(self.sim.data.qfrc_applied)
+        assert self.walker.failures == 0
+
+    def moved(self) -> np.ndarray:
+        """(forward, leftward) of the pelvis since the start, in the start's frame (it faces +x)."""
+        return (self.truth.floating_base()[0] - self.start)[:2]
+
+
+def test_nothing_holds_the_biped_up_but_its_motors():
+    sim = open_floor()
+    assert sim.model.neq == 0  # no weld, no equality constraint anywhere in the scene
+    assert sim.model.body_mocapid[sim.model.body(sim.robot_root).id] == -1  # the pelvis is no mocap body
+
+
+def test_it_walks_forwards_at_0_3_m_per_s_and_keeps_its_line():
+    walk = Walk()
+    walk.walker.command(0.3)
+    walk.run(10.0)
+    forward, sideways = walk.moved()
+    assert forward > 0.3 * (10.0 - 1.0)  # the first second shifts the weight and takes the first step
+    assert abs(sideways) < 0.1 and abs(math.degrees(walk.turned)) < 5.0
+    # the estimator's legged odometry stays with the truth: under 2 cm per metre walked
+    estimate = walk.walker.state.position
+    assert np.linalg.norm((estimate - walk.truth.floating_base()[0])[:2]) < 0.02 * forward
+
+
+@pytest.mark.parametrize(("command", "expected"), [((-0.15, 0.0, 0.0), (-0.45, 0.0)), ((0.0, 0.08, 0.0), (0.0, 0.24))])
+def test_it_walks_backwards_and_sideways(command, expected):
+    walk = Walk()
+    walk.walker.command(*command)
+    walk.run(4.0)
+    assert walk.moved() == pytest.approx(expected, abs=0.12)
+    assert abs(math.degrees(walk.turned)) < 5.0
+
+
+def test_it_turns_a_full_circle_in_place():
+    walk = Walk()
+    walk.walker.command(0.0, 0.0, 0.3)
+    while walk.turned < 2 * math.pi:
+        walk.run(0.5)
+        assert walk.sim.time < 30.0
+    walk.walker.brake()
+    walk.run(2.5)
+    assert walk.walker.phase is Phase.STANDING
+    assert np.linalg.norm(walk.moved()) < 0.15
+
+
+def test_a_stop_brings_it_to_a_stand_within_two_steps():
+    walk = Walk()
+    walk.walker.command(0.3)
+    walk.run(3.05)
+    assert walk.walker.phase is Phase.SINGLE  # a foot in the air when the stop comes
+    taken = len(walk.walker.touchdowns)
+    walk.walker.brake()
+    walk.run(2.0)
+    assert walk.walker.phase is Phase.STANDING
+    assert len(walk.walker.touchdowns) - taken <= 2
+    left, right = walk.walker.feet
+    assert walk.walker.planner.together(left, right, tolerance=0.02)
+
+
+def test_the_walking_base_walks_to_a_pose_goal_facing_the_way():
+    sim = open_floor()
+    truth = GroundTruth(sim)
+    base = WalkingBase(sim)
+    x, y, _ = base.pose()
+    handle = base.move_to(x + 1.0, y + 0.6, math.radians(90.0))
+    while not handle.done:
+        base.step()
+        sim.step(5)
+        assert sim.time < 20.0
+    assert handle.status.name == "SUCCEEDED", handle.result
+    tx, ty, tyaw = truth.robot_pose()
+    assert math.hypot(tx - x - 1.0, ty - y - 0.6) < 0.05
+    assert abs(math.degrees(math.remainder(tyaw - math.pi / 2, 2 * math.pi))) < 5.0
+
+
+def test_a_base_motion_mission_runs_on_the_biped():
+    scenario = run_scenario(
+        {
+            "mission": "walk to the kitchen",
+            "world": "apartment",
+            "robot": "biped_humanoid",
+            "tree": {"sequence": [{"turn": {"yaw": 90}}, {"navigate": {"place": "kitchen"}}]},
+            "success": [{"at": "kitchen"}],
+        }
+    )
+    assert scenario.result.success, scenario.result.cause
+    assert not any("_sole_" not in mine for mine, _ in scenario.run.truth.robot_contacts())
