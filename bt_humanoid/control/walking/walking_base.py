@@ -32,6 +32,8 @@ POSITION_GAIN = 1.0  # 1/s: body velocity per metre (radian) of error from a str
 LARGEST_TURN = math.pi / 2  # rad of a long turn fed to the walker at once (its goals wrap at half a circle)
 FINAL_STRETCH = 0.5  # m from a pose goal within which the robot turns to the goal's heading; before, to the goal
 GOAL_TIMEOUT = 10.0
+SETTLED_SPEED = 0.02  # m/s of the pelvis below which a robot standing after its last step has settled
+OFFSET_FILTER = 0.01  # per control step: the pelvis's offset from the centre of mass, averaged over about a second
 # m/s a streamed reference may ask sideways: about what a pair of sidesteps covers (0.12 m in 1.4 s); more turns
 # into steps at the edges of what the legs reach while they walk forwards and turn as well
 SIDEWAYS_SPEED = 0.08  # s beyond the time a pose goal should take at the allowed speeds before it fails
@@ -51,7 +53,8 @@ class WalkingBase(SpeedMonitoring):
         sim.physics_controllers.append(self.walker.step)
         self.walker.observe()  # odometry from the first instant, before any physics step
         stance = standing_posture(sim.robot, posture=posture)
-        self.stance_offset = stance.qpos[:2].copy()  # the pelvis from the middle of the feet, facing +x
+        #: the pelvis from the middle of the feet, facing +x: the stance's to start with, then as measured
+        self.stance_offset = stance.qpos[:2] - stance.com[:2]
         self.speed_cap = self.config.limits.max_speed
         self.handle: MotionHandle | None = None
         self.target: np.ndarray | None = None  # a pose goal's base pose (yaw unwrapped)
@@ -128,6 +131,13 @@ class WalkingBase(SpeedMonitoring):
         pose = self.pose()
         self._yaw += wrap(pose[2] - self._last_yaw)
         self._last_yaw = pose[2]
+        # the pelvis from the centre of mass, which the walker stands over the middle of the feet: it moves when
+        # the arms do (tucked, holding something), and a goal for the pelvis is one for the feet offset by it
+        com = self.walker.dynamics.com
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        dx, dy = pose[0] - com[0], pose[1] - com[1]
+        measured = np.array([c * dx + s * dy, -s * dx + c * dy])
+        self.stance_offset += OFFSET_FILTER * (measured - self.stance_offset)
         if self.target is not None:
             self._towards_goal(pose)
         elif self.reference is not None:
@@ -156,7 +166,8 @@ class WalkingBase(SpeedMonitoring):
         error = float(np.hypot(x - pose[0], y - pose[1]))
         yaw_error = abs(math.degrees(remaining_turn))
         handle.feedback = f"{error:.2f} m to go, heading off by {yaw_error:.0f}°"
-        standing = self.walker.phase is Phase.STANDING
+        # standing, and settled: the centre of mass comes to rest over the middle of the feet after the last step
+        standing = self.walker.phase is Phase.STANDING and float(np.hypot(*self.speeds()[:2])) < SETTLED_SPEED
         tolerance = self.config.tolerance
         if standing and error < tolerance.position and yaw_error < tolerance.yaw_deg:
             handle.succeed(f"arrived within {error * 100:.1f} cm, {yaw_error:.1f}°")
