@@ -8,8 +8,10 @@ import math
 import numpy as np
 import pytest
 
+from bt_humanoid.control.walking.balance import LIMP_DAMPING
 from bt_humanoid.control.walking.walker import Phase, WalkingController
 from bt_humanoid.control.walking.walking_base import WalkingBase
+from bt_humanoid.safety.monitors import FallMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig
@@ -138,3 +140,27 @@ def test_a_base_motion_mission_runs_on_the_biped():
     )
     assert scenario.result.success, scenario.result.cause
     assert not any("_sole_" not in mine for mine, _ in scenario.run.truth.robot_contacts())
+
+
+def test_a_fall_is_caught_by_the_robots_own_sensors_and_leaves_the_legs_limp():
+    sim = open_floor()
+    walker = WalkingController(sim)
+    legs = sim.robot.legs
+    feet = {sim.model.body(leg.foot).id for leg in (legs.left, legs.right)}
+    monitor = FallMonitor(lambda: walker.fallen, sim.model, sim.data, sim.robot_bodies, feet)
+    pelvis = sim.model.body("pelvis").id
+    for _ in range(round(0.5 / sim.timestep)):  # standing: nothing to report
+        walker.step()
+        sim.step()
+    assert monitor.check(sim.time) is None
+    sim.data.xfrc_applied[pelvis, :3] = [600.0, 0.0, 0.0]  # four times what the ankles and hips can take
+    while walker.fallen is None and sim.time < 3.0:
+        walker.step()
+        sim.step()
+    sim.data.xfrc_applied[pelvis, :3] = 0.0
+    assert walker.fallen is not None and monitor.check(sim.time).startswith("fell: ")
+    for _ in range(200):
+        sim.step()
+    walker.step()  # fallen: the leg motors only damp, against the velocities just read
+    velocities = walker.io.velocities()[walker._leg_columns]
+    assert sim.data.ctrl[walker._leg_actuators] == pytest.approx(-LIMP_DAMPING * velocities)

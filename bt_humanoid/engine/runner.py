@@ -25,6 +25,7 @@ from bt_humanoid.perception.perceiver import Perceiver
 from bt_humanoid.safety.monitors import (
     BumperMonitor,
     DroppedMonitor,
+    FallMonitor,
     JointLimitMonitor,
     SafetySupervisor,
     StopRequestMonitor,
@@ -121,6 +122,11 @@ class MissionRun:
             TimeBudgetMonitor(self.time_budget, sim.time),
             WorkspaceMonitor(robot, np.array(stack.world.bounds), defaults.min_hand_height),
         ]
+        if robot.walking is not None and robot_config.legs is not None:  # a biped can fall
+            legs = robot_config.legs
+            feet = {sim.model.body(leg.foot).id for leg in (legs.left, legs.right)}
+            walker = robot.walking.walker
+            monitors.insert(1, FallMonitor(lambda: walker.fallen, sim.model, sim.data, sim.robot_bodies, feet))
         branch_monitors = [
             DroppedMonitor(robot.grippers, lambda: stack.context.world_model),
             StrainMonitor(sim.model, sim.data, limbs, defaults.strain_time),  # not wheels, not fingers

@@ -74,6 +74,45 @@ class StopRequestMonitor:
         return self.reason
 
 
+class FallMonitor:
+    """Fires when a walking robot falls: by its own sensors (the IMU's tilt, the pelvis's height over its feet:
+    ``fall_reason``), or when anything of it but a foot touches the floor (its skin, as the bumper's).
+
+    The walking controller has already made the robot safe by then (its legs only damp, docs/walking.md); the
+    mission stops as for any safety violation.
+    """
+
+    name = "fall"
+
+    def __init__(
+        self,
+        fall_reason: Callable[[], str | None],
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        robot: set[int],
+        feet: set[int],
+    ) -> None:
+        self.fall_reason = fall_reason
+        self.data = data
+        self.model = model
+        self.skin = np.isin(model.geom_bodyid, sorted(robot - feet))  # per geom: the robot, not its feet
+        self.floor = model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE
+
+    def check(self, now: float) -> str | None:
+        reason = self.fall_reason()
+        if reason is not None:
+            return f"fell: {reason}"
+        contacts = self.data.contact
+        pairs = np.stack([contacts.geom1, contacts.geom2], axis=1)
+        down = self.skin[pairs] & self.floor[pairs[:, ::-1]]
+        rows, sides = np.nonzero(down)
+        if rows.size:
+            geom = int(pairs[rows[0], sides[0]])
+            part = self.model.geom(geom).name or self.model.body(self.model.geom_bodyid[geom]).name
+            return f"fell: the robot's {part} is on the floor"
+        return None
+
+
 class JointLimitMonitor:
     """Fires when a joint is past its MJCF range by more than the margin, or faster than its speed limit.
 

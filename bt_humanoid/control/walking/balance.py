@@ -50,6 +50,11 @@ LEG_POSTURE_WEIGHT = 0.1
 LEG_POSTURE_GAINS = (10.0, 6.0)
 SERVO_SPEED_LIMIT = 3.0  # rad/s (m/s) the QP lets an upper-body joint reach: the arms' servos are not motors
 HELD_JOINTS_GAIN = 10.0
+# A fall, by the robot's own sensors: the pelvis (the IMU) tilted further than this from upright, or lower than
+# this above the feet (standing it is 0.52 m up). Walking tilts it a few degrees; no recovery comes back from 30°.
+MAX_TILT_DEG = 30.0
+FALLEN_HEIGHT = 0.35  # m
+LIMP_DAMPING = 5.0  # N·m·s/rad at each leg joint of a fallen robot
 
 
 class BalanceController:
@@ -134,14 +139,40 @@ class BalanceController:
         self.solve_times: list[float] = []  # s per control step building and solving the QP, for the benchmark
         self.conic_times: list[float] = []  # s of each in DAQP itself
         self.failures = 0  # control steps whose QP had no solution (the last command was held)
+        self.fallen: str | None = None  # why the robot fell, once it has: it then only damps its legs
 
     # --- the control step ---------------------------------------------------------------------------------------
 
     def step(self) -> None:
-        """Read the sensors, estimate, solve the QP, command the actuators."""
+        """Read the sensors, estimate, solve the QP, command the actuators; once fallen, only damp the legs."""
         positions, velocities = self.observe()
+        if self.fallen is None:
+            self.fallen = self.fall_reason()
+        if self.fallen is not None:
+            self._go_limp(velocities)
+            return
         self._balance()
         self._command(positions, velocities)
+
+    def fall_reason(self) -> str | None:
+        """Why the robot has fallen (or is falling past saving) by its own sensors; None while it stands."""
+        state = self.state
+        assert state is not None
+        tilt = math.degrees(math.acos(float(np.clip(state.rotation[2, 2], -1.0, 1.0))))
+        if tilt > MAX_TILT_DEG:
+            return f"the pelvis tilts {tilt:.0f}° from upright (more than {MAX_TILT_DEG:.0f}°)"
+        soles = [self.dynamics.pose(c.frame).translation[2] for c in self.contacts]
+        height = float(state.position[2] - min(soles))
+        if height < FALLEN_HEIGHT:
+            return f"the pelvis is {height:.2f} m above the feet (lowest standing {FALLEN_HEIGHT:g} m)"
+        return None
+
+    def _go_limp(self, velocities: np.ndarray) -> None:
+        """A fallen robot's safe state: the legs' motors only damp their joints (no torque drives a limb into the
+        floor or a person), the upper body's servos hold where they are."""
+        io = self.io
+        io.command(self._leg_actuators, -LIMP_DAMPING * velocities[self._leg_columns])
+        io.command(self._servo_actuators, io.positions()[self._servo_columns])
 
     def observe(self) -> tuple[np.ndarray, np.ndarray]:
         """Read the sensors and update the state estimate and the model there (no command); the joints' positions
