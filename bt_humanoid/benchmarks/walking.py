@@ -12,7 +12,7 @@ On the open floor (worlds/open_floor), with the walking controller alone (docs/w
    stand, and how far it drifts standing after;
 3. pushes on the pelvis of ``--impulse`` (30 N·s: 150 N for 0.2 s) towards random directions, ``--pushes`` while
    standing and as many while walking at ``--push-speed`` (0.3 m/s; at a random moment of the gait): survived
-   when no robot geom but a sole touches anything and the pelvis stays above 0.4 m for 3 s after the push;
+   when nothing of the robot but its feet touches anything and the pelvis stays above 0.4 m for 3 s after it;
    the share survived, and the largest push survived towards each of eight directions while walking
    (bisection to 5 N over 0.2 s).
 
@@ -40,6 +40,11 @@ STANDING_HEIGHT = 0.4  # m: a pelvis below this has fallen
 PUSH_TIME = 0.2  # s
 SETTLE = 3.0  # s after a push before judging
 LOWEST, HIGHEST, RESOLUTION = 50.0, 400.0, 5.0  # N: the largest-push bisection's bracket and resolution
+
+
+def on_a_foot(geom: str) -> bool:
+    """A geom of a foot: its sole's corners or its box (which touches the floor when the foot rolls 3°)."""
+    return "_sole_" in geom or geom in ("l_foot", "r_foot")
 
 
 class Fell(Exception):
@@ -85,7 +90,7 @@ class Trial:
                     abs(math.remainder(state.yaw - yaw, 2 * math.pi)),
                 )
             )
-            if position[2] < STANDING_HEIGHT or any("_sole_" not in m for m, _ in self.truth.robot_contacts()):
+            if position[2] < STANDING_HEIGHT or any(not on_a_foot(m) for m, _ in self.truth.robot_contacts()):
                 raise Fell(f"fell at {sim.time:.2f} s")
             if until is not None and until():
                 return

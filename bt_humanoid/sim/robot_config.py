@@ -142,6 +142,16 @@ class StanceConfig(StrictModel):
     width: float = Field(gt=0, description="m between the sole centres")
 
 
+class GaitConfig(StrictModel):
+    """How the robot walks (bt_humanoid.control.walking): the timing of its steps and where its feet go."""
+
+    single_support: float = Field(0.45, gt=0, description="s with one foot in the air")
+    double_support: float = Field(0.1, gt=0, description="s passing the weight from one foot to the other")
+    width: float = Field(0.22, gt=0, description="m between the sole centres while walking")
+    step_height: float = Field(0.05, gt=0, description="m the swinging foot clears the floor")
+    shortest_swing: float = Field(0.25, gt=0, description="s: the soonest a pushed robot may land a swinging foot")
+
+
 class LegsConfig(StrictModel):
     """Two torque-controlled legs under a floating base: what a walking controller needs beyond the MJCF."""
 
@@ -149,6 +159,7 @@ class LegsConfig(StrictModel):
     right: LegConfig
     sole: SoleConfig
     stance: StanceConfig
+    gait: GaitConfig = GaitConfig()
     torque_limits: dict[str, float] = Field(description="N·m per joint role (the motors' ctrlrange in the MJCF)")
     speed_limits: dict[str, float] = Field(description="rad/s per joint role: the motors' no-load speed")
 

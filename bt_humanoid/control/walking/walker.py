@@ -1,7 +1,7 @@
 """Walking: footsteps, the DCM plan through them, the swinging foot, all on the standing controller's QP.
 
-A gait of fixed timing (docs/walking.md): single support ``SINGLE_SUPPORT`` s, one foot swinging; double support
-``DOUBLE_SUPPORT`` s, the weight passing from one foot to the other. On each new phase the controller plans the
+A gait of fixed timing (robot.yaml ``legs.gait``, docs/walking.md): single support, one foot swinging; double
+support, the weight passing from one foot to the other. On each new phase the controller plans the
 next footsteps for its velocity command (``FootstepPlanner``), and through them a ZMP reference and the DCM that
 goes with it (``DcmPlan``); every control step the balance law tracks that DCM (``BalanceController._track``) and
 a frame task carries the swinging sole along its ``SwingTrajectory``. The soles' contacts follow the phase: both
@@ -28,11 +28,8 @@ from bt_humanoid.control.wbc.contact import MIN_NORMAL_FORCE
 from bt_humanoid.control.wbc.id_tasks import FrameTask
 from bt_humanoid.sim.simulation import Simulation
 
-SINGLE_SUPPORT = 0.6  # s with one foot in the air
-DOUBLE_SUPPORT = 0.1  # s passing the weight from foot to foot
 START_SHIFT = 0.4  # s moving the weight onto the first stance foot before the first step
 END_SHIFT = 0.4  # s moving it back to the middle of the feet after the last
-STEP_HEIGHT = 0.05  # m the swinging foot clears the floor
 PLANNED_STEPS = 3  # footsteps planned ahead: the DCM plan's horizon (2.1 s, e^{−ωT} ≈ 4e-4)
 # 1/s: walking's DCM gain. The plan's DCM moves, and a stiff law would throw the centre of pressure to the soles'
 # edges at every small error; the design's 2.5 lets the error decay over a step (docs/walking.md)
@@ -44,7 +41,6 @@ SWING_GAINS = (400.0, 40.0)  # K_p (1/s²), K_d (1/s): the swing foot follows it
 ROOM_SHARE = 0.8
 # where a footstep may go to recover from a push: further than walking's steps, as far as the legs reach
 RECOVERY_LIMITS = StepLimits(forward=(-0.25, 0.35), sideways=(0.14, 0.40), yaw=(-0.1, 0.4))
-MIN_SWING = 0.3  # s: the shortest a swing may be made to land a pushed robot's foot sooner
 TIMING_CANDIDATES = 8  # landing times tried, from the nominal one to the soonest
 REACH_TOLERANCE = 0.01  # m: a footstep this near to the one wanted is as good
 GOAL_TOLERANCE = 0.01  # m: a body this near its goal has arrived, and steps no more
@@ -69,8 +65,8 @@ class WalkingController(BalanceController):
         super().__init__(sim, posture)
         legs = self.config.legs
         assert legs is not None
-        width = legs.stance.width if legs.stance is not None else 0.18
-        self.planner = FootstepPlanner(width, SINGLE_SUPPORT + DOUBLE_SUPPORT, StepLimits())
+        self.gait = gait = legs.gait
+        self.planner = FootstepPlanner(gait.width, gait.single_support + gait.double_support, StepLimits())
         self.swing_tasks = [
             FrameTask(contact.frame, SWING_WEIGHT, SWING_GAINS[0], SWING_GAINS[1]) for contact in self.contacts
         ]
@@ -178,10 +174,10 @@ class WalkingController(BalanceController):
         pose = self.dynamics.pose(self.contacts[step.side].frame)
         start = np.array([*pose.translation, _yaw(pose.rotation)])
         end = np.array([step.x, step.y, self._sole_height(1 - step.side), step.yaw])  # flat floor: the stance's
-        self.swing = SwingTrajectory(start, end, SINGLE_SUPPORT, STEP_HEIGHT)
+        self.swing = SwingTrajectory(start, end, self.gait.single_support, self.gait.step_height)
         self._nominal_step = step
         self.phase = Phase.SINGLE
-        self.phase_start, self.phase_end = now, now + SINGLE_SUPPORT
+        self.phase_start, self.phase_end = now, now + self.gait.single_support
         assert self.plan is not None
         self._touchdown_dcm = self.plan.at(self.phase_end)[1]  # where the plan has the DCM at touchdown
 
@@ -203,7 +199,7 @@ class WalkingController(BalanceController):
             self.steps = [self.planner.closing_step(landed)]
         zmp_from = self.feet[1 - step.side].position
         if self.steps:
-            self._double_support(now, DOUBLE_SUPPORT, zmp_from)
+            self._double_support(now, self.gait.double_support, zmp_from)
         else:
             self._double_support(now, END_SHIFT, zmp_from)
 
@@ -222,13 +218,13 @@ class WalkingController(BalanceController):
         feet = list(self.feet)
         for step in self.steps:
             stance = feet[1 - step.side].position
-            times += [t, t + SINGLE_SUPPORT]
+            times += [t, t + self.gait.single_support]
             zmps += [stance, stance]
-            t += SINGLE_SUPPORT + DOUBLE_SUPPORT
+            t += self.planner.period
             feet[step.side] = step
         middle = (feet[LEFT].position + feet[RIGHT].position) / 2
         if self.steps:
-            times.append(t - DOUBLE_SUPPORT + END_SHIFT)
+            times.append(t - self.gait.double_support + END_SHIFT)
         else:
             times.append(t)
         zmps.append(middle)
@@ -273,10 +269,10 @@ class WalkingController(BalanceController):
         ξ(τ) = p + (ξ − p) e^{ω τ}: the footstep moves by what that adds to the plan's DCM at touchdown, less the
         room the new sole will have. The nominal landing time is kept while that footstep is within what the
         legs can reach (``RECOVERY_LIMITS``); otherwise the foot lands sooner, as soon as the swing allows
-        (``MIN_SWING``), where the DCM has gone less far. Once the foot is coming down, nothing changes.
+        (``legs.gait.shortest_swing``), where the DCM has gone less far. Once the foot is coming down, nothing changes.
         """
         elapsed, remaining = now - self.phase_start, self.phase_end - now
-        if self.plan is None or self.feet is None or remaining < LIFT_SHARE * SINGLE_SUPPORT:
+        if self.plan is None or self.feet is None or remaining < LIFT_SHARE * self.gait.single_support:
             return
         nominal = self._nominal_step
         assert self.swing is not None and nominal is not None
@@ -291,7 +287,7 @@ class WalkingController(BalanceController):
             return
         pivot = stance.position + room * direction  # the centre of pressure, at the sole's edge
         offset = self._touchdown_dcm - nominal.position  # the plan's DCM from the footstep at touchdown
-        shortest = max(MIN_SWING - elapsed, LIFT_SHARE * SINGLE_SUPPORT)
+        shortest = max(self.gait.shortest_swing - elapsed, LIFT_SHARE * self.gait.single_support)
         best: tuple[float, float, Footstep] | None = None
         for duration in np.linspace(remaining, min(shortest, remaining), TIMING_CANDIDATES):
             needed = pivot + (dcm - pivot) * math.exp(self.omega * duration) - offset - room * direction
