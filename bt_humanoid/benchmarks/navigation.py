@@ -14,7 +14,7 @@ route on the same map. Runs pinned to one CPU core; ``--json PATH`` also
 writes the figures.
 
 ``--robot biped_humanoid`` walks the same runs: judged within 10 cm and 10° (its goals are footsteps), its
-soles' contacts with the floor are not counted as contacts, and falls are counted (the pelvis below 0.35 m,
+feet's contacts with the floor are not counted as contacts, and falls are counted (the pelvis below 0.35 m,
 or anything but a sole touching the floor).
 """
 
@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
+from bt_humanoid.benchmarks.walking import on_a_foot
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.navigation.grid_astar import grid_route_length
 from bt_humanoid.testing.scenario import build_run
@@ -104,7 +105,7 @@ def run_one(
         nonlocal fell
         touching = run.truth.robot_contacts()
         if floating:  # a biped stands on its soles: those contacts with the floor are its footing
-            touching = [(mine, other) for mine, other in touching if not ("_sole_" in mine and other == "floor")]
+            touching = [(mine, other) for mine, other in touching if not (on_a_foot(mine) and other == "floor")]
             fell = fell or run.truth.floating_base()[0][2] < FALLEN_HEIGHT or any(o == "floor" for _, o in touching)
         contacts.extend(touching)
         x, y, _ = run.truth.robot_pose()

@@ -145,7 +145,7 @@ class StanceConfig(StrictModel):
 class GaitConfig(StrictModel):
     """How the robot walks (bt_humanoid.control.walking): the timing of its steps and where its feet go."""
 
-    single_support: float = Field(0.45, gt=0, description="s with one foot in the air")
+    single_support: float = Field(0.6, gt=0, description="s with one foot in the air")
     double_support: float = Field(0.1, gt=0, description="s passing the weight from one foot to the other")
     width: float = Field(0.22, gt=0, description="m between the sole centres while walking")
     step_height: float = Field(0.05, gt=0, description="m the swinging foot clears the floor")

@@ -80,6 +80,8 @@ def lift_what_is_held(context: SkillContext) -> MotionHandle | None:
 class _ManipulationSkill(PhasedSkill):
     """Shared helpers: reach limits, the carry pose."""
 
+    needs_whole_body = True
+
     def _keepout(self, region: np.ndarray) -> list[Limit]:
         """Keep the base's footprint off a rectangle of the floor ([[x0, y0], [x1, y1]]: furniture reached over)
         and off the map's walls, while it helps a reach."""

@@ -318,7 +318,9 @@ class WalkingController(BalanceController):
         """The body velocity the next footsteps are planned for, from a body at ``body``: the command, or what
         takes the body to the goal. Towards a goal one step moves the body forward by v T and a pair of steps
         sideways and round by 2 v T (``FootstepPlanner``), so the velocity that lands on the goal is the
-        distance over one period forward and over two sideways and round, within the goal's speeds."""
+        distance over one period forward and over two sideways and round; it is scaled as a whole to what the
+        legs can do (``capabilities``), so the body goes straight to the goal, turning as it goes, as a wheeled
+        base does."""
         if self.goal is None:
             return self.velocity
         dx, dy, dyaw = Footstep(LEFT, *self.goal).relative_to(body)
@@ -326,12 +328,22 @@ class WalkingController(BalanceController):
             return np.zeros(3)
         period = self.planner.period
         velocity = np.array([dx / period, dy / (2 * period), dyaw / (2 * period)])
-        max_speed, max_yaw_rate = self.goal_speeds
-        speed = float(np.hypot(velocity[0], velocity[1]))
-        if speed > max_speed:
-            velocity[:2] *= max_speed / speed
-        velocity[2] = float(np.clip(velocity[2], -max_yaw_rate, max_yaw_rate))
-        return velocity
+        forward, backward, sideways, turning = self.capabilities()
+        caps = np.array([forward if dx >= 0 else backward, sideways, turning])
+        caps[0] = min(caps[0], self.goal_speeds[0])
+        caps[2] = min(caps[2], self.goal_speeds[1])
+        scale = min(1.0, float(np.min(caps / np.maximum(np.abs(velocity), 1e-9))))
+        return velocity * scale
+
+    def capabilities(self) -> tuple[float, float, float, float]:
+        """The fastest the footsteps can carry the body: forward, backward, sideways (m/s) and turning (rad/s)."""
+        limits, period = self.planner.limits, self.planner.period
+        return (
+            limits.forward[1] / period,
+            -limits.forward[0] / period,
+            (limits.sideways[1] - self.planner.width) / (2 * period),
+            limits.yaw[1] / (2 * period),
+        )
 
     @staticmethod
     def _moving(velocity: np.ndarray) -> bool:

@@ -30,7 +30,6 @@ from bt_humanoid.sim.standing import standing_posture
 
 POSITION_GAIN = 1.0  # 1/s: body velocity per metre (radian) of error from a streamed reference
 LARGEST_TURN = math.pi / 2  # rad of a long turn fed to the walker at once (its goals wrap at half a circle)
-FINAL_STRETCH = 0.5  # m from a pose goal within which the robot turns to the goal's heading; before, to the goal
 GOAL_TIMEOUT = 10.0
 SETTLED_SPEED = 0.02  # m/s of the pelvis below which a robot standing after its last step has settled
 OFFSET_FILTER = 0.01  # per control step: the pelvis's offset from the centre of mass, averaged over about a second
@@ -59,7 +58,6 @@ class WalkingBase(SpeedMonitoring):
         self.handle: MotionHandle | None = None
         self.target: np.ndarray | None = None  # a pose goal's base pose (yaw unwrapped)
         self.goal_speed = 0.0
-        self._final_stretch = False
         self.deadline = 0.0
         self.reference: np.ndarray | None = None  # a streamed reference (track)
         self.reference_velocity = np.zeros(3)
@@ -101,10 +99,14 @@ class WalkingBase(SpeedMonitoring):
         self.reference = None
         distance = float(np.hypot(x - start[0], y - start[1]))
         limits = self.config.limits
-        # facing the way, walking, facing the goal's heading: two turns of at most half a circle each, and the walk
-        turns = abs(turn) + 2 * math.pi if distance > FINAL_STRETCH else abs(turn)
-        self.deadline = self.time + distance / self.goal_speed + turns / limits.max_yaw_rate + GOAL_TIMEOUT
-        self._final_stretch = False
+        # straight there, turning as it goes, at what the legs can do along the slowest axis (sideways, mostly)
+        forward, _, sideways, turning = self.walker.capabilities()
+        c, s = math.cos(start[2]), math.sin(start[2])
+        along, across = abs(c * (x - start[0]) + s * (y - start[1])), abs(-s * (x - start[0]) + c * (y - start[1]))
+        expected = max(
+            along / min(forward, self.goal_speed), across / sideways, abs(turn) / min(turning, limits.max_yaw_rate)
+        )
+        self.deadline = self.time + 2 * expected + GOAL_TIMEOUT
         self.reset_hold()
         self.handle = MotionHandle(f"walking {distance:.2f} m", on_cancel=lambda _: self.brake())
         return self.handle
@@ -148,11 +150,6 @@ class WalkingBase(SpeedMonitoring):
         x, y, yaw = self.target
         remaining_turn = yaw - self._yaw
         heading = self._yaw + float(np.clip(remaining_turn, -LARGEST_TURN, LARGEST_TURN))
-        # far from the goal, face the way to it: a biped walks forwards three times as fast as sideways
-        distance = float(np.hypot(x - pose[0], y - pose[1]))
-        self._final_stretch = self._final_stretch or distance < FINAL_STRETCH
-        if not self._final_stretch:
-            heading = math.atan2(y - pose[1], x - pose[0])
         share = self.allowed_share(np.array([self.goal_speed, self.goal_speed, self.config.limits.max_yaw_rate]))
         held = self.held_too_long(share, self.time)
         handle = self.handle
