@@ -323,3 +323,44 @@ def test_an_unknown_parameter_is_refused_even_when_its_value_is_a_reference(tmp_
     path = write(tmp_path, "m.yaml", "mission: x\ntree:\n  stand_near: {objekt: $cube}\n")
     code, err = validate(capsys, path)
     assert code == 2 and err.startswith("error: ") and err.endswith("m.yaml:3: stand_near: unknown parameter 'objekt'")
+
+
+def test_a_skill_the_walking_robot_cannot_do_yet_is_refused_naming_the_step_and_what_it_can(tmp_path, capsys):
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
+        mission: fetch on legs
+        world: apartment
+        robot: biped_humanoid
+        tree:
+          sequence:
+            - navigate: {place: table}
+            - pick: {object: red cube}
+        """,
+    )
+    code, err = validate(capsys, path)
+    assert code == 2
+    assert "m.yaml:7" in err and "pick" in err and "biped_humanoid" in err
+    assert "navigate" in err and "move_base" in err  # what a mission on it may use
+    assert len(err.splitlines()) <= 2 and "Traceback" not in err
+
+
+def test_robot_option_runs_a_mission_file_on_another_robot(tmp_path):
+    from bt_humanoid.mission.loader import MissionLoader
+
+    path = write(
+        tmp_path,
+        "m.yaml",
+        """
+        mission: walk
+        world: apartment
+        robot: wheeled_humanoid
+        tree:
+          move_base: {x: 0.5, y: 0.0, yaw: 0}
+        """,
+    )
+    spec = MissionLoader(robot="biped_humanoid").load_file(path)
+    assert spec.header.robot == "biped_humanoid" and spec.known.robot_config.base.floating
+    with pytest.raises(UserError, match="unknown robot|no robot|not a robot"):
+        MissionLoader(robot="tripod").load_file(path)

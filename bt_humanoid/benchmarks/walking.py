@@ -7,7 +7,7 @@ On the open floor (worlds/open_floor), with the walking controller alone (docs/w
 1. straight: 0.3 m/s forwards for ``--seconds`` (60): distance, average speed, sideways drift, heading drift,
    the state estimator's position error per metre walked and its yaw error, the inverse-dynamics QP's time per
    control step (median, p95; DAQP's share), the whole control step's, and the real-time factor with physics;
-2. a full turn in place at 0.3 rad/s; backwards at 0.15 m/s and sideways at 0.08 m/s for 10 s each; an arc
+2. a full turn in place at 0.3 rad/s; backwards at 0.15 m/s and sideways at 0.05 m/s for 10 s each; an arc
    (0.25 m/s turning 0.2 rad/s) for 20 s; start and stop (0.3 m/s, a stop in mid-swing): the steps it takes to
    stand, and how far it drifts standing after;
 3. pushes on the pelvis of ``--impulse`` (30 N·s: 150 N for 0.2 s) towards random directions, ``--pushes`` while
@@ -241,7 +241,7 @@ def main(argv: list[str] | None = None) -> int:
         "straight": _run(f"straight at 0.3 m/s for {args.seconds:g} s", straight, args.seconds),
         "turn_in_place": _run("a full turn in place at 0.3 rad/s", turn_in_place),
         "backwards": _run("backwards at 0.15 m/s for 10 s", constant, (-0.15, 0.0, 0.0), 10.0),
-        "sideways": _run("sideways at 0.08 m/s for 10 s", constant, (0.0, 0.08, 0.0), 10.0),
+        "sideways": _run("sideways at 0.05 m/s for 10 s", constant, (0.0, 0.05, 0.0), 10.0),
         "arc": _run("an arc at 0.25 m/s, 0.2 rad/s for 20 s", constant, (0.25, 0.0, 0.2), 20.0),
         "start_stop": _run("start and stop", start_stop),
     }

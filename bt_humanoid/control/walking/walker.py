@@ -23,6 +23,7 @@ import pinocchio as pin
 from bt_humanoid.control.walking.balance import DCM_GAIN, BalanceController
 from bt_humanoid.control.walking.dcm_plan import DcmPlan
 from bt_humanoid.control.walking.footsteps import LEFT, RIGHT, Footstep, FootstepPlanner, StepLimits
+from bt_humanoid.control.walking.stepping import Sole, capture_step, cop_room
 from bt_humanoid.control.walking.swing import LIFT_SHARE, SwingTrajectory
 from bt_humanoid.control.wbc.contact import MIN_NORMAL_FORCE
 from bt_humanoid.control.wbc.id_tasks import FrameTask
@@ -41,8 +42,6 @@ SWING_GAINS = (400.0, 40.0)  # K_p (1/s²), K_d (1/s): the swing foot follows it
 ROOM_SHARE = 0.8
 # where a footstep may go to recover from a push: further than walking's steps, as far as the legs reach
 RECOVERY_LIMITS = StepLimits(forward=(-0.25, 0.35), sideways=(0.14, 0.40), yaw=(-0.1, 0.4))
-TIMING_CANDIDATES = 8  # landing times tried, from the nominal one to the soonest
-REACH_TOLERANCE = 0.01  # m: a footstep this near to the one wanted is as good
 GOAL_TOLERANCE = 0.01  # m: a body this near its goal has arrived, and steps no more
 GOAL_YAW_TOLERANCE = 0.01  # rad
 STILL = 1e-3  # a command below this (m/s, rad/s) is no command
@@ -66,6 +65,8 @@ class WalkingController(BalanceController):
         legs = self.config.legs
         assert legs is not None
         self.gait = gait = legs.gait
+        sole = self.contacts[0]
+        self._sole = Sole(sole.length / 2 - sole.cop_margin, sole.width / 2 - sole.cop_margin)
         self.planner = FootstepPlanner(gait.width, gait.single_support + gait.double_support, StepLimits())
         self.swing_tasks = [
             FrameTask(contact.frame, SWING_WEIGHT, SWING_GAINS[0], SWING_GAINS[1]) for contact in self.contacts
@@ -85,7 +86,6 @@ class WalkingController(BalanceController):
         self._nominal_step: Footstep | None = None  # the swinging foot's planned footstep, before adjustment
         self._touchdown_dcm = np.zeros(2)
         self.dcm_error = 0.0  # m between the DCM and the plan's, last computed in single support
-        self.trace: list | None = None
         self.touchdowns: list[Footstep] = []  # every footstep taken, where the sole was at touchdown
 
     # --- the interface -------------------------------------------------------------------------------------------
@@ -187,8 +187,6 @@ class WalkingController(BalanceController):
         landed = self._measured(step.side)
         self.feet[step.side] = landed
         self.touchdowns.append(landed)
-        if self.trace is not None:
-            self.trace.append((now, landed, self.goal))
         self.swing = None
         velocity = self._planning_velocity(self.planner.body(landed))
         if self._moving(velocity):
@@ -260,59 +258,39 @@ class WalkingController(BalanceController):
             self.tasks.append(task)
 
     def _adjust_step(self, now: float) -> None:
-        """Move the swinging foot's footstep, and land it sooner, where it captures the DCM (docs/walking.md,
-        step adjustment; after Khadiv et al., "Walking control based on step timing adaptation", 2020).
-
-        While the DCM error e = ξ − ξ_ref is within what the stance sole's centre of pressure can answer (its
-        ``room`` that way), the balance law's ankle torque makes it decay and the footstep stays. Beyond, the
-        centre of pressure stops at the sole's edge, p = pivot + room ê, and the DCM runs away as
-        ξ(τ) = p + (ξ − p) e^{ω τ}: the footstep moves by what that adds to the plan's DCM at touchdown, less the
-        room the new sole will have. The nominal landing time is kept while that footstep is within what the
-        legs can reach (``RECOVERY_LIMITS``); otherwise the foot lands sooner, as soon as the swing allows
-        (``legs.gait.shortest_swing``), where the DCM has gone less far. Once the foot is coming down, nothing changes.
-        """
+        """Move the swinging foot's footstep, and land it sooner, where it captures the DCM (``capture_step``);
+        once the foot is coming down, nothing changes."""
         elapsed, remaining = now - self.phase_start, self.phase_end - now
-        if self.plan is None or self.feet is None or remaining < LIFT_SHARE * self.gait.single_support:
+        single = self.gait.single_support
+        if self.plan is None or self.feet is None or remaining < LIFT_SHARE * single:
             return
         nominal = self._nominal_step
         assert self.swing is not None and nominal is not None
         stance = self.feet[1 - nominal.side]
-        _, dcm_reference, _ = self.plan.at(now)
-        dcm = self.dcm()
+        dcm, dcm_reference = self.dcm(), self.plan.at(now)[1]
         error = dcm - dcm_reference
-        self.dcm_error = size = float(np.linalg.norm(error))
-        direction = error / max(size, 1e-9)
-        room = self._room(stance, direction)
-        if size <= room:
+        self.dcm_error = float(np.linalg.norm(error))
+        room = cop_room(stance, error / max(self.dcm_error, 1e-9), self._sole, ROOM_SHARE)
+        shortest = max(self.gait.shortest_swing - elapsed, LIFT_SHARE * single)
+        adjusted = capture_step(
+            nominal,
+            stance,
+            dcm,
+            dcm_reference,
+            self._touchdown_dcm,
+            self.omega,
+            remaining,
+            shortest,
+            room,
+            RECOVERY_LIMITS,
+        )
+        if adjusted is None:
             return
-        pivot = stance.position + room * direction  # the centre of pressure, at the sole's edge
-        offset = self._touchdown_dcm - nominal.position  # the plan's DCM from the footstep at touchdown
-        shortest = max(self.gait.shortest_swing - elapsed, LIFT_SHARE * self.gait.single_support)
-        best: tuple[float, float, Footstep] | None = None
-        for duration in np.linspace(remaining, min(shortest, remaining), TIMING_CANDIDATES):
-            needed = pivot + (dcm - pivot) * math.exp(self.omega * duration) - offset - room * direction
-            wanted = Footstep(nominal.side, float(needed[0]), float(needed[1]), nominal.yaw)
-            target = RECOVERY_LIMITS.clip(wanted, stance)
-            miss = float(np.linalg.norm(target.position - wanted.position))
-            if best is None or miss < best[0] - REACH_TOLERANCE:
-                best = (miss, float(duration), target)
-            if miss <= REACH_TOLERANCE:
-                break
-        assert best is not None
-        _, duration, target = best
+        target, duration = adjusted
         if target != self.steps[0] or duration < remaining - 1e-9:
             self.steps[0] = target
             self.phase_end = now + duration
             self.swing.retarget(elapsed, np.array([target.x, target.y, target.yaw]), elapsed + duration)
-
-    def _room(self, stance: Footstep, direction: np.ndarray) -> float:
-        """How far the centre of pressure may go from the stance sole's centre towards ``direction`` (world, unit):
-        to the edge of the sole's rectangle, less the cone's margin, times ``ROOM_SHARE``."""
-        c, s = math.cos(stance.yaw), math.sin(stance.yaw)
-        along, across = abs(c * direction[0] + s * direction[1]), abs(-s * direction[0] + c * direction[1])
-        contact = self.contacts[stance.side]
-        half_length, half_width = contact.length / 2 - contact.cop_margin, contact.width / 2 - contact.cop_margin
-        return ROOM_SHARE * min(half_length / max(along, 1e-9), half_width / max(across, 1e-9))
 
     def _planning_velocity(self, body: Footstep) -> np.ndarray:
         """The body velocity the next footsteps are planned for, from a body at ``body``: the command, or what
