@@ -48,7 +48,9 @@ UPPER_BODY_WEIGHT = 10.0
 UPPER_BODY_GAINS = (100.0, 20.0)
 LEG_POSTURE_WEIGHT = 0.1
 LEG_POSTURE_GAINS = (10.0, 6.0)
-SERVO_SPEED_LIMIT = 3.0  # rad/s (m/s) the QP lets an upper-body joint reach: the arms' servos are not motors
+# the QP lets an upper-body joint reach this times its motion limit (robot.yaml joint_limits: what its joint
+# trajectories plan under); a servo is not a motor, and the QP does not drive it faster than its plans do
+SERVO_SPEED_MARGIN = 1.5
 HELD_JOINTS_GAIN = 10.0
 # A fall, by the robot's own sensors: the pelvis (the IMU) tilted further than this from upright, or lower than
 # this above the feet (standing it is 0.52 m up). Walking tilts it a few degrees; no recovery comes back from 30°.
@@ -103,7 +105,12 @@ class BalanceController:
         controlled = self.legs + self.servoed
         model = sim.model
         ranges = np.array([model.jnt_range[model.joint(j).id] for j in controlled])
-        speeds = np.array([legs.speed_limit(j) if j in legs.joints else SERVO_SPEED_LIMIT for j in controlled])
+        speeds = np.array(
+            [
+                legs.speed_limit(j) if j in legs.joints else SERVO_SPEED_MARGIN * config.motion_limits(j).velocity
+                for j in controlled
+            ]
+        )
         self.torque_limit = TorqueLimit(
             {j: legs.torque_limit(j) for j in self.legs} | {j: s[2] for j, s in zip(self.servoed, servos, strict=True)}
         )

@@ -44,6 +44,8 @@ ROOM_SHARE = 0.8
 RECOVERY_LIMITS = StepLimits(forward=(-0.25, 0.35), sideways=(0.14, 0.40), yaw=(-0.1, 0.4))
 GOAL_TOLERANCE = 0.01  # m: a body this near its goal has arrived, and steps no more
 GOAL_YAW_TOLERANCE = 0.01  # rad
+SET_OFF_DISTANCE = 0.03  # m and rad from a goal beyond which a standing robot sets off towards it
+SET_OFF_TURN = 0.05
 STILL = 1e-3  # a command below this (m/s, rad/s) is no command
 
 
@@ -140,7 +142,7 @@ class WalkingController(BalanceController):
         """Move to the next phase when this one is over; keep the swinging foot's task on its path."""
         now = self.time
         if self.phase is Phase.STANDING:
-            if self._moving(self._planning_velocity(self.body())):
+            if self._moving(self._planning_velocity(self.body())) and not self._near_goal(self.body()):
                 self._start_walking(now)
         elif self.phase is Phase.DOUBLE and now >= self.phase_end:
             if self.steps:
@@ -322,6 +324,14 @@ class WalkingController(BalanceController):
             (limits.sideways[1] - self.planner.width) / (2 * period),
             limits.yaw[1] / (2 * period),
         )
+
+    def _near_goal(self, body: Footstep) -> bool:
+        """Standing this near a goal, the robot does not set off: the goal's small shifts (the arms moving the
+        pelvis over the feet) are not worth a step. Once walking, it steps to within ``GOAL_TOLERANCE``."""
+        if self.goal is None:
+            return False
+        dx, dy, dyaw = Footstep(LEFT, *self.goal).relative_to(body)
+        return math.hypot(dx, dy) < SET_OFF_DISTANCE and abs(dyaw) < SET_OFF_TURN
 
     @staticmethod
     def _moving(velocity: np.ndarray) -> bool:

@@ -169,6 +169,8 @@ class WalkingBase(SpeedMonitoring):
         if standing and error < tolerance.position and yaw_error < tolerance.yaw_deg:
             handle.succeed(f"arrived within {error * 100:.1f} cm, {yaw_error:.1f}°")
             self.handle = None
+            self.target = None
+            self.walker.brake()  # arrived: stand here, whatever the arms do next
         elif self.time > self.deadline:
             handle.fail(f"stopped {error:.2f} m and {yaw_error:.0f}° from the goal")
             self.brake()

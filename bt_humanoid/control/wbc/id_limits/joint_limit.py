@@ -7,11 +7,15 @@ import numpy as np
 from bt_humanoid.control.wbc.dynamics import RobotDynamics
 
 HORIZON = 0.1  # s: a joint must be able to stop inside its range within this, given its speed now
+# s over which a joint faster than its limit is brought back under it: within one 2 ms step the deceleration
+# (and its reaction on the floating base) would be more than the feet's contact can take, and the QP infeasible
+SPEED_HORIZON = 0.05
 
 
 class JointLimit:
     """Position and speed bounds for ``joints``: v̇ keeps the position reached under constant acceleration over
-    ``horizon`` inside [lower + margin, upper − margin], and the next step's speed within ±max_velocity.
+    ``horizon`` inside [lower + margin, upper − margin], and brings the speed within ±max_velocity over
+    ``SPEED_HORIZON`` (at once, if that is under a step).
 
     Bounds that cannot both hold (a joint already outside, or too fast to stop in time) give way to the
     position one's direction: any acceleration back inside is allowed."""
@@ -41,8 +45,9 @@ class JointLimit:
         # q + v t + ½ v̇ t² within the range
         low = 2.0 * (self.lower - q - v * t) / t**2
         high = 2.0 * (self.upper - q - v * t) / t**2
-        low = np.maximum(low, (-self.max_velocity - v) / dt)
-        high = np.minimum(high, (self.max_velocity - v) / dt)
+        slowing = max(dt, SPEED_HORIZON)
+        low = np.maximum(low, (-self.max_velocity - v) / slowing)
+        high = np.minimum(high, (self.max_velocity - v) / slowing)
         low = np.minimum(low, high)  # conflicting: the range's side wins (any acceleration back in)
         lower, upper = np.full(dynamics.nv, -np.inf), np.full(dynamics.nv, np.inf)
         lower[columns], upper[columns] = low, high
