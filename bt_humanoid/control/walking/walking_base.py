@@ -52,7 +52,8 @@ class WalkingBase(SpeedMonitoring):
         sim.physics_controllers.append(self.walker.step)
         self.walker.observe()  # odometry from the first instant, before any physics step
         stance = standing_posture(sim.robot, posture=posture)
-        #: the pelvis from the middle of the feet, facing +x: the stance's to start with, then as measured
+        #: the pelvis from the centre of mass, which stands over the middle of the feet, in the body's frame: the
+        #: stance's to start with, then as measured (``step``)
         self.stance_offset = stance.qpos[:2] - stance.com[:2]
         self.speed_cap = self.config.limits.max_speed
         self.handle: MotionHandle | None = None
