@@ -362,5 +362,5 @@ def test_robot_option_runs_a_mission_file_on_another_robot(tmp_path):
     )
     spec = MissionLoader(robot="biped_humanoid").load_file(path)
     assert spec.header.robot == "biped_humanoid" and spec.known.robot_config.base.floating
-    with pytest.raises(UserError, match="unknown robot|no robot|not a robot"):
+    with pytest.raises(UserError, match=r"unknown robot|no robot|not a robot"):
         MissionLoader(robot="tripod").load_file(path)
