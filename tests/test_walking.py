@@ -164,3 +164,15 @@ def test_a_fall_is_caught_by_the_robots_own_sensors_and_leaves_the_legs_limp():
     walker.step()  # fallen: the leg motors only damp, against the velocities just read
     velocities = walker.io.velocities()[walker._leg_columns]
     assert sim.data.ctrl[walker._leg_actuators] == pytest.approx(-LIMP_DAMPING * velocities)
+
+
+def test_the_bipeds_own_belief_of_its_head_and_hands_matches_the_truth():
+    """The navigator tips the head by where the camera is; on the biped that comes from the walker's model."""
+    run = run_scenario(
+        {"mission": "stand", "world": "apartment", "robot": "biped_humanoid", "tree": {"wait": {"seconds": 1}}}
+    ).run
+    sim, frames = run.sim, run.robot.config.frames
+    for name in ("head_camera", "left_hand", "right_hand"):
+        kind, mjcf = frames[name]
+        truth = {"site": sim.data.site, "camera": sim.data.cam}[kind](mjcf).xpos
+        assert np.linalg.norm(run.robot.frame_position(mjcf) - truth) < 0.02, name

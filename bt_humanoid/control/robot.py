@@ -111,12 +111,16 @@ class RobotController:
         self.base.brake()
         self.joints.brake()
 
-    def hand_position(self, side: str) -> np.ndarray:
-        """Where the ``side`` gripper's grip point is (world), from the encoders and odometry."""
+    def frame_position(self, frame: str) -> np.ndarray:
+        """Where a frame of the robot's model is (world), from the encoders and odometry."""
         if self.whole_body is not None:
-            return self.whole_body.frame_pose(self.whole_body.hand_frame(side)).translation.copy()
+            return self.whole_body.frame_pose(frame).translation.copy()
         assert self.walking is not None
-        return self.walking.walker.dynamics.pose(self.config.grippers[side].grip_site).translation.copy()
+        return self.walking.walker.dynamics.pose(frame).translation.copy()
+
+    def hand_position(self, side: str) -> np.ndarray:
+        """Where the ``side`` gripper's grip point is (world)."""
+        return self.frame_position(self.config.grippers[side].grip_site)
 
     def joint_positions(self) -> dict[str, float]:
         return dict(zip(self.body_io.joints, self.body_io.positions().tolist(), strict=False))

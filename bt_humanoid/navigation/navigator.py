@@ -245,7 +245,7 @@ class Navigator:
         targets = {self.head_pan: float(np.clip(bearing, -MAX_GAZE_PAN, MAX_GAZE_PAN))}
         tilt = self.robot.config.head_tilt
         if at_floor and tilt is not None and self.camera_frame is not None:
-            camera = self.robot.whole_body.frame_pose(self.camera_frame).translation
+            camera = self.robot.frame_position(self.camera_frame)
             targets[tilt] = math.atan2(camera[2], float(np.hypot(*(point[:2] - camera[:2]))))
         self.robot.joints.move(targets)
 
