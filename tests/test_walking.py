@@ -112,6 +112,28 @@ def test_a_stop_brings_it_to_a_stand_within_two_steps():
     assert walk.walker.planner.together(left, right, tolerance=0.02)
 
 
+def test_a_command_that_comes_back_while_stopping_sets_off_from_a_stand():
+    """A route's stop and go: walking again before it stood, the robot first stands, then sets off, and the
+    DCM stays with its plan (set off from the stopping plan, its reference jumped 10 cm, the step adjustment
+    took that for a push, and it fell)."""
+    walk = Walk()
+    walker = walk.walker
+    walker.command(0.3)
+    walk.run(2.5)
+    walker.brake()
+    while not (walker.phase is Phase.SINGLE and len(walker.steps) == 1):  # the last step is in the air
+        walk.run(0.01)
+        assert walk.sim.time < 5.0
+    walker.command(0.0, 0.05, 0.3)
+    steps_taken, worst = len(walker.touchdowns), 0.0
+    for _ in range(250):
+        walk.run(0.01)
+        if walker.plan is not None:
+            worst = max(worst, float(np.linalg.norm(walker.dcm() - walker.plan.at(walker.time)[1])))
+    assert worst < 0.04
+    assert len(walker.touchdowns) >= steps_taken + 2  # the last step, and walking again
+
+
 def test_the_walking_base_walks_to_a_pose_goal_facing_the_way():
     sim = open_floor()
     truth = GroundTruth(sim)

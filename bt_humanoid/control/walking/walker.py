@@ -9,7 +9,10 @@ stand in double support, the leaving foot's load ramped down to nothing by lift-
 support while the other transmits nothing.
 
 A zero command stops: the foot in the air lands where it was going, and one more step brings the feet side by
-side (``brake``: two steps at most), then the robot stands on the standing controller's law.
+side (``brake``: two steps at most), then the robot stands on the standing controller's law. A command that
+comes back while it stops is taken up once it stands: the stopping plan's DCM heads for the middle of the feet,
+and a walking plan begun from there asked the centre of pressure for more than a sole has (a route's stop and
+go tipped the robot over).
 """
 
 from __future__ import annotations
@@ -186,12 +189,13 @@ class WalkingController(BalanceController):
     def _land(self, now: float) -> None:
         assert self.feet is not None
         step = self.steps.pop(0)
+        stopping = not self.steps  # the plan ended with this step: the robot is coming to a stand
         landed = self._measured(step.side)
         self.feet[step.side] = landed
         self.touchdowns.append(landed)
         self.swing = None
         velocity = self._planning_velocity(self.planner.body(landed))
-        if self._moving(velocity):
+        if self._moving(velocity) and not stopping:
             self.steps = self.planner.plan(landed, velocity, PLANNED_STEPS)
         elif self.planner.together(self.feet[LEFT], self.feet[RIGHT]):
             self.steps = []
