@@ -165,11 +165,11 @@ class RobotStack:
         if config.scanner is None:
             return None
         model = self.sim.model
-        base_body = int(model.jnt_bodyid[model.joint(config.base.joints["yaw"]).id])
-        whole_body = self.robot.whole_body
+        base_body = model.body(self.sim.robot_root).id  # the scanner rides the body the base joints move
+        robot = self.robot
 
         def hands() -> list[np.ndarray]:
-            return [whole_body.frame_pose(whole_body.hand_frame(side)).translation for side in config.grippers]
+            return [robot.hand_position(side) for side in config.grippers]
 
         def zone(name: str, distance: float) -> None:
             self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))
