@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
 from bt_humanoid.control.walking.balance import LIMP_DAMPING
 from bt_humanoid.control.walking.walker import Phase, WalkingController
 from bt_humanoid.control.walking.walking_base import WalkingBase
+from bt_humanoid.perception.safety_scanner import SafetyScanner
 from bt_humanoid.safety.monitors import FallMonitor
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.robot_config import load_robot_config
@@ -198,3 +200,15 @@ def test_the_bipeds_own_belief_of_its_head_and_hands_matches_the_truth():
         kind, mjcf = frames[name]
         truth = {"site": sim.data.site, "camera": sim.data.cam}[kind](mjcf).xpos
         assert np.linalg.norm(run.robot.frame_position(mjcf) - truth) < 0.02, name
+
+
+def test_the_bipeds_safety_scanner_drops_its_own_legs():
+    sim = open_floor()
+    mujoco.mj_forward(sim.model, sim.data)
+    root = sim.model.body(sim.robot_root).id
+    config = load_robot_config("biped_humanoid").scanner
+    assert config is not None
+    blind = SafetyScanner(sim.model, sim.data, root, config).scan()
+    assert blind is not None and len(blind) > 0  # the legs cross the scan plane
+    scanner = SafetyScanner(sim.model, sim.data, root, config, own=sim.robot_bodies)
+    assert len(scanner.scan()) == 0  # nothing on the open floor within range, and the legs are not something

@@ -175,7 +175,7 @@ class RobotStack:
             self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))
 
         separation = SpeedAndSeparation(
-            SafetyScanner(model, self.sim.data, base_body, config.scanner),
+            SafetyScanner(model, self.sim.data, base_body, config.scanner, own=self.sim.robot_bodies),
             config.safety,
             config.base.footprint_radius,
             config.base.limits.max_speed,

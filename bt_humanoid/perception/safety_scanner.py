@@ -4,7 +4,9 @@ Mobile robots that work near people carry one (the head camera looks where
 the robot goes; the scanner also sees who comes from the side or behind).
 Each ray is cast through the scene (``raycast``) from the scanner's
 current pose, as a real scanner measures time of flight; the robot's own
-base is skipped, as a scanner's housing is.
+base is skipped, as a scanner's housing is. On a robot whose legs cross the
+scan plane, hits on its own bodies (``own``) are dropped: the legs blind those
+few rays, as they would a real scanner's.
 """
 
 from __future__ import annotations
@@ -21,9 +23,17 @@ from bt_humanoid.sim.robot_config import ScannerConfig
 class SafetyScanner:
     """``scan()`` gives the floor points (x, y) where the rays hit something, once per scan period."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, base_body: int, config: ScannerConfig) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        base_body: int,
+        config: ScannerConfig,
+        own: set[int] | None = None,
+    ) -> None:
         self.model, self.data = model, data
         self.base_body = base_body
+        self._own_geom = np.isin(model.geom_bodyid, sorted(own or ()))  # geoms of the robot's own bodies
         self.config = config
         self._angles = np.linspace(0.0, 2 * math.pi, config.rays, endpoint=False)
         self._geom_ids = np.zeros(config.rays, dtype=np.int32)
@@ -54,4 +64,5 @@ class SafetyScanner:
             self.base_body,
         )
         hit = self._geom_ids >= 0
+        hit[hit] = ~self._own_geom[self._geom_ids[hit]]
         return origin[:2] + directions[hit, :2] * self._distances[hit, None]
