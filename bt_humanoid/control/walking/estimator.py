@@ -16,7 +16,10 @@ The IMU's readings are one physics step older than the encoders': MuJoCo compute
 that starts a step, before it integrates, so after ``mj_step`` the attitude and rates are those of the step's
 start (a real IMU has a latency of its own). The attitude is carried forward over that latency with the gyro.
 
-Contact is the touch sensor's normal force with hysteresis (on above 30 N, off below 15 N). Absolute position is
+Contact is the touch sensor's normal force with hysteresis (on above 30 N, off below 15 N). A sole in contact is
+trusted to stand still only while the velocity it implies agrees with the prediction (within ``SLIP_SPEED``): a
+swinging foot that scuffs the floor, or a sole that slides, touches without standing, and taking it for still
+once made the estimate lose 0.6 m/s in a step (a pushed robot then stepped backwards and fell). Absolute position is
 not observable from these sensors: the filter starts from a known start (the feet centred on the world's start
 pose, flat on the floor) and from there integrates, as legged odometry does.
 """
@@ -40,6 +43,9 @@ SWING_FOOT_DRIFT = 5.0  # m/√s: a lifted foot may go anywhere; the kinematics 
 KINEMATICS_NOISE = 0.002  # m (1σ) of a sole's position relative to the IMU from the encoders
 VELOCITY_NOISE = 0.02  # m/s (1σ) of the IMU's velocity implied by a still sole
 INITIAL_POSITION_SPREAD = 1e-3  # m (1σ): the start pose is known
+# m/s between a touching sole's implied IMU velocity and the prediction beyond which the sole is not standing
+# still (it scuffs or slides): an impact changes the body's velocity by less within a step, a scuff by far more
+SLIP_SPEED = 0.25
 
 
 @dataclass
@@ -136,19 +142,19 @@ class StateEstimator:
         x = self.x
         x[0:3] += x[3:6] * dt + 0.5 * acceleration * dt**2
         x[3:6] += acceleration * dt
-        contacts = (self._contact[0], self._contact[1])
+        # measurements: each sole relative to the IMU; a standing sole's stillness gives the IMU's velocity
+        relative, rates = self._kinematics(joint_positions, joint_velocities)
+        offsets = [rotation @ r for r in relative]
+        implied = [-_cross(omega, offsets[side]) - rotation @ rates[side] for side in (0, 1)]
+        contacts = self._still_soles(implied, x[3:6])
         F, Q, H, noise = self._filter_model(contacts, dt)
         P = F @ self.P @ F.T
         P[self._diagonal] += Q
-
-        # measurements: each sole relative to the IMU; a standing sole's stillness gives the IMU's velocity
-        relative, rates = self._kinematics(joint_positions, joint_velocities)
         values = []
         for side in (0, 1):
-            offset = rotation @ relative[side]
-            values.append(offset)
+            values.append(offsets[side])
             if contacts[side]:
-                values.append(-_cross(omega, offset) - rotation @ rates[side])
+                values.append(implied[side])
         innovation = np.concatenate(values) - H @ x
         PH = P @ H.T
         S = H @ PH
@@ -171,6 +177,16 @@ class StateEstimator:
             contacts=(self._contact[0], self._contact[1]),
         )
         return self.state
+
+    def _still_soles(self, implied: list[np.ndarray], predicted: np.ndarray) -> tuple[bool, bool]:
+        """Which touching soles stand still: those whose implied IMU velocity agrees with the prediction. If none
+        does, the one that agrees best: the filter is not left to the accelerometer alone."""
+        touching = [side for side in (0, 1) if self._contact[side]]
+        misfit = {side: float(np.linalg.norm(implied[side] - predicted)) for side in touching}
+        still = [side for side in touching if misfit[side] <= SLIP_SPEED]
+        if not still and touching:
+            still = [min(touching, key=misfit.__getitem__)]
+        return (0 in still, 1 in still)
 
     # --- outputs -------------------------------------------------------------------------------------------------
 
