@@ -1,4 +1,4 @@
-"""Command-line entry points: bt-run, bt-plan and bt-validate.
+"""Command-line entry points: bt-run, bt-plan, bt-validate and bt-export.
 
 Exit codes: 0 success, 1 mission failed, 2 invalid input. A user error is one
 line on stderr naming the place and what would be valid; never a traceback.
@@ -419,11 +419,14 @@ def mission_schema() -> dict:
 
 
 def validate_file(file: Path) -> str:
-    """Validate a mission or behaviour file; returns a one-line description, raises UserError."""
+    """Validate a mission or behaviour file (YAML, or BehaviorTree.CPP XML); returns a one-line description,
+    raises UserError."""
     from bt_humanoid.mission.behaviors import load_behavior
     from bt_humanoid.mission.loader import MissionLoader
     from bt_humanoid.yaml_source import read_yaml
 
+    if file.suffix.lower() == ".xml":
+        return _validate_xml(file)
     source = read_yaml(file)
     if isinstance(source.data, dict) and "behavior" in source.data:
         behavior = load_behavior(file)
@@ -438,12 +441,34 @@ def validate_file(file: Path) -> str:
     return f"mission '{spec.header.mission}' ({count} nodes)"
 
 
+def _validate_xml(file: Path) -> str:
+    """A BehaviorTree.CPP XML mission, or a behaviour (checked, as in YAML, in a throw-away mission)."""
+    from bt_humanoid.interop.btcpp_import import read_btcpp
+    from bt_humanoid.mission.behaviors import BehaviorLibrary
+    from bt_humanoid.mission.loader import MissionLoader
+
+    library = BehaviorLibrary()
+    imported = read_btcpp(file, library=library)
+    if imported.source is None:
+        name = imported.document.behavior
+        loader = MissionLoader(library=imported.library(library), check_world=False)
+        behavior = loader.library.behaviors[name]
+        loader.load_data({"mission": f"check {name}", "tree": {name: _default_args(behavior)}}, str(file))
+        return f"behaviour '{name}' (BehaviorTree.CPP XML)"
+    spec = MissionLoader().load_file(file)
+    count = sum(1 for _ in spec.tree.walk())
+    return f"mission '{spec.header.mission}' ({count} nodes, BehaviorTree.CPP XML)"
+
+
 def _print_expanded(file: Path, console: Console) -> None:
     """The mission in ``file`` as it will run (a behaviour has no robot or world to resolve against)."""
     from bt_humanoid.engine.expand import expand
     from bt_humanoid.mission.loader import MissionLoader
     from bt_humanoid.yaml_source import read_yaml
 
+    if file.suffix.lower() == ".xml":
+        console.print(expand(MissionLoader().load_file(file)), markup=False)
+        return
     source = read_yaml(file)
     if isinstance(source.data, dict) and "behavior" in source.data:
         console.print("  (a behaviour: --expand shows missions; call it from one to see it expanded)")
@@ -482,6 +507,45 @@ def validate_main(argv: list[str] | None = None) -> int:
                 _print_expanded(file, console)
     except UserError as error:
         return _fail_invalid(error)
+    return EXIT_OK
+
+
+# --- bt-export ----------------------------------------------------------------------------
+
+
+def _export_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="bt-export",
+        description="Write a mission or behaviour as BehaviorTree.CPP v4 XML (for Groot2, Nav2 and BehaviorTree.CPP).",
+    )
+    parser.add_argument("file", type=Path, help="mission or behaviour YAML file (or BehaviorTree.CPP XML, rewritten)")
+    parser.add_argument("-o", "--output", type=Path, metavar="FILE.xml", help="write here (default: stdout)")
+    parser.add_argument(
+        "--no-wrappers",
+        action="store_true",
+        help="the mission's own tree, without the safety and recovery wrappers the compiler adds: the form "
+        "bt-run and bt-validate read back",
+    )
+    return parser
+
+
+def export_main(argv: list[str] | None = None) -> int:
+    args = _export_parser().parse_args(argv)
+    console = Console(highlight=False, soft_wrap=True, stderr=True)
+    try:
+        from bt_humanoid.interop.btcpp import export_file
+
+        text, note = export_file(args.file, wrappers=not args.no_wrappers)
+    except UserError as error:
+        return _fail_invalid(error)
+    if note:
+        console.print(note)
+    if args.output is None:
+        sys.stdout.write(text)
+    else:
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        args.output.write_text(text)
+        console.print(f"wrote {args.output}")
     return EXIT_OK
 
 
