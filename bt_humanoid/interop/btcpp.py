@@ -43,6 +43,10 @@ def export_file(file: Path, wrappers: bool = True) -> tuple[str, str | None]:
     """The XML for ``file``, and a note for the user (or None)."""
     document, spec = load_document(file)
     if spec is None:
-        note = None if not wrappers else "a behaviour is written without wrappers: the compiler adds them where a mission calls it"
+        note = (
+            None
+            if not wrappers
+            else "a behaviour is written without wrappers: the compiler adds them where a mission calls it"
+        )
         return export_btcpp(document), note
     return export_btcpp(document, compile_for_export(spec) if wrappers else None), None

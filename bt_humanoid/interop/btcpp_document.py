@@ -71,6 +71,14 @@ def document_from_yaml(file: Path, library: BehaviorLibrary | None = None) -> Do
     return document
 
 
+def complete(document: Document, library: BehaviorLibrary) -> None:
+    """Add the library's behaviours that the document calls but does not define (an XML file may call
+    behaviors/ by name), transitively."""
+    for behavior in list(document.behaviors.values()):
+        _collect(behavior.tree, document, library, document.file or Path("."))
+    _collect(document.tree, document, library, document.file or Path("."))
+
+
 def _collect(node: Any, document: Document, library: BehaviorLibrary, file: Path) -> None:
     """Add the behaviours ``node`` calls (by name, or as ``subtree: {file}``) to the document, depth first."""
     if not isinstance(node, dict):
@@ -92,6 +100,8 @@ def _collect(node: Any, document: Document, library: BehaviorLibrary, file: Path
             _collect(child, document, library, file)
         for key in ("condition", "child"):
             _collect((body or {}).get(key), document, library, file)
+    elif kind in document.behaviors:
+        return  # defined in the document, or collected already (its calls with it)
     elif kind in library.behaviors:
         behavior = library.behaviors[kind]
         _add(behavior_def(behavior.source), document, library, behavior.source.file)

@@ -133,7 +133,9 @@ class _Exporter:
                     attrs.append(("default", encode(spec.default, spec.annotation)))
                 ports.append(El("input_port", attrs=attrs, text=spec.description or ""))
             category = "Condition" if info.is_condition else "Action"
-            models.append(El(category, attrs=[("ID", name)], children=[*ports, El("description", text=info.description)]))
+            models.append(
+                El(category, attrs=[("ID", name)], children=[*ports, El("description", text=info.description)])
+            )
         # a compiled tree holds the compiler's wrappers; a mission tree, a node's own recovery
         customs: tuple[CustomNode, ...] = (ROUND_ROBIN, *WRAPPERS) if self.compiled is not None else MISSION_NODES
         for node in customs:
@@ -141,7 +143,9 @@ class _Exporter:
                 El("input_port", attrs=[("name", n), ("type", t)] + ([("default", d)] if d is not None else []), text=s)
                 for n, t, d, s in node.ports
             ]
-            models.append(El(node.category, attrs=[("ID", node.id)], children=[*ports, El("description", text=node.description)]))
+            models.append(
+                El(node.category, attrs=[("ID", node.id)], children=[*ports, El("description", text=node.description)])
+            )
         for tree_id in self.trees:
             behavior = self.document.behaviors.get(tree_id.rsplit("@", 1)[0])
             if behavior is not None:
@@ -168,7 +172,8 @@ class _Exporter:
         kind = kind_of(data)
         element = self._inner(kind, data[kind], params, inner)
         if data.get("name") is not None:
-            element.attrs.insert(0, ("name", data["name"]))
+            first = 1 if element.attrs and element.attrs[0][0] == "ID" else 0  # a SubTree's ID leads
+            element.attrs.insert(first, ("name", data["name"]))
         if guard is not None:
             return self._wrapped(element, chain, data, kind, params)
         recovery = data.get("recovery")
@@ -201,7 +206,9 @@ class _Exporter:
             return El("Parallel", attrs=attrs, children=[child(c, i) for i, c in enumerate(body["children"])])
         if kind == "guard":
             self.used.add("ReactiveSequence")
-            return self._control(El("ReactiveSequence", children=[child(body["condition"], 0), child(body["child"], 1)]))
+            return self._control(
+                El("ReactiveSequence", children=[child(body["condition"], 0), child(body["child"], 1)])
+            )
         if kind in DECORATOR_TAGS:
             tag, port, setting = DECORATOR_TAGS[kind]
             self.used.add(tag)
@@ -210,7 +217,10 @@ class _Exporter:
         if kind in REGISTRY:
             info = REGISTRY[kind]
             fields = info.params.model_fields
-            attrs = [(name, encode(value, fields[name].annotation if name in fields else Any, params)) for name, value in (body or {}).items()]
+            attrs = [
+                (name, encode(value, fields[name].annotation if name in fields else Any, params))
+                for name, value in (body or {}).items()
+            ]
             return El(kind, "Condition" if info.is_condition else "Action", attrs)
         if kind == "subtree":
             behavior = self.document.behaviors[self.document.subtree_files[body["file"]]]
@@ -260,7 +270,9 @@ class _Exporter:
 
     # --- the compiler's wrappers ------------------------------------------------------------
 
-    def _wrapped(self, element: El, chain: list[Behaviour], data: dict[str, Any], kind: str, params: frozenset[str]) -> El:
+    def _wrapped(
+        self, element: El, chain: list[Behaviour], data: dict[str, Any], kind: str, params: frozenset[str]
+    ) -> El:
         self.used.add("SafetyGuard")
         for wrapper in reversed(chain):
             if isinstance(wrapper, OrElse):
@@ -302,8 +314,12 @@ def _unwrap(guard: Behaviour) -> tuple[list[Behaviour], Behaviour]:
 
 def _quote(text: str) -> str:
     escaped = (
-        text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
-        .replace("\n", "&#10;").replace("\t", "&#9;")
+        text.replace("&", "&amp;")
+        .replace("<", "&lt;")
+        .replace(">", "&gt;")
+        .replace('"', "&quot;")
+        .replace("\n", "&#10;")
+        .replace("\t", "&#9;")
     )
     return f'"{escaped}"'
 

@@ -17,8 +17,14 @@ from typing import Any
 from pydantic import ValidationError
 
 from bt_humanoid.errors import UserError, did_you_mean
-from bt_humanoid.interop.btcpp_document import BehaviorDef, Document
-from bt_humanoid.interop.btcpp_export import BEHAVIOR_MARK, MISSION_MARK, PARAM_ANNOTATIONS, PARAM_TYPES, RECOVERY_FIELDS
+from bt_humanoid.interop.btcpp_document import BehaviorDef, Document, complete
+from bt_humanoid.interop.btcpp_export import (
+    BEHAVIOR_MARK,
+    MISSION_MARK,
+    PARAM_ANNOTATIONS,
+    PARAM_TYPES,
+    RECOVERY_FIELDS,
+)
 from bt_humanoid.interop.btcpp_nodes import (
     MISSION_NODE_IDS,
     SCRIPTED_ATTRIBUTES,
@@ -72,10 +78,10 @@ class _Reader:
     def read(self) -> ImportedXml:
         root = self.xml.root
         if root.tag != "root":
-            raise self.fail(root, f"a BehaviorTree.CPP file starts with <root BTCPP_format=\"4\">, not <{root.tag}>")
+            raise self.fail(root, f'a BehaviorTree.CPP file starts with <root BTCPP_format="4">, not <{root.tag}>')
         version = root.attrs.get("BTCPP_format", "4")
         if version != "4":
-            raise self.fail(root, f"BTCPP_format=\"{version}\": this reads BehaviorTree.CPP v4 XML (BTCPP_format=\"4\")")
+            raise self.fail(root, f'BTCPP_format="{version}": this reads BehaviorTree.CPP v4 XML (BTCPP_format="4")')
         trees: dict[str, XmlElement] = {}
         models: dict[str, XmlElement] = {}
         for child in root.children:
@@ -86,14 +92,18 @@ class _Reader:
                 if tree_id in trees:
                     raise self.fail(child, f"two <BehaviorTree>s are called '{tree_id}'")
                 if len(child.children) != 1:
-                    raise self.fail(child, f"<BehaviorTree ID=\"{tree_id}\"> holds exactly one node, found {len(child.children)}")
+                    raise self.fail(
+                        child, f'<BehaviorTree ID="{tree_id}"> holds exactly one node, found {len(child.children)}'
+                    )
                 trees[tree_id] = child
             elif child.tag == "TreeNodesModel":
                 models |= {m.attrs.get("ID", ""): m for m in child.children if m.tag == "SubTree"}
             elif child.tag == "include":
                 raise self.fail(child, "<include> is not read here", hint="put the subtrees in this one file")
             else:
-                raise self.fail(child, f"unexpected <{child.tag}> in <root>", hint="valid: BehaviorTree, TreeNodesModel")
+                raise self.fail(
+                    child, f"unexpected <{child.tag}> in <root>", hint="valid: BehaviorTree, TreeNodesModel"
+                )
         if not trees:
             raise self.fail(root, "no <BehaviorTree> in the file")
         main = root.attrs.get("main_tree_to_execute")
@@ -102,7 +112,9 @@ class _Reader:
                 raise self.fail(root, "main_tree_to_execute is needed with more than one <BehaviorTree>")
             main = next(iter(trees))
         if main not in trees:
-            raise self.fail(root, f"main_tree_to_execute=\"{main}\": no such <BehaviorTree>", hint=did_you_mean(main, trees))
+            raise self.fail(
+                root, f'main_tree_to_execute="{main}": no such <BehaviorTree>', hint=did_you_mean(main, trees)
+            )
         mark, header, header_lines = self._header()
         is_behavior = mark == BEHAVIOR_MARK
         if is_behavior and header.get("behavior") != main:
@@ -110,7 +122,9 @@ class _Reader:
         self.subtrees = {tree_id for tree_id in trees if is_behavior or tree_id != main}
         for tree_id in self.subtrees:
             if tree_id in REGISTRY or tree_id in structural_kinds():
-                raise self.fail(trees[tree_id], f"a subtree may not be called '{tree_id}': that is a skill or node kind")
+                raise self.fail(
+                    trees[tree_id], f"a subtree may not be called '{tree_id}': that is a skill or node kind"
+                )
         self.params = {tree_id: self._params(tree_id, models.get(tree_id), trees) for tree_id in self.subtrees}
         definitions: dict[str, BehaviorDef] = {}
         behaviors: dict[str, Behavior] = {}
@@ -120,16 +134,20 @@ class _Reader:
             tree = self.node(trees[tree_id].children[0], ("tree",), frozenset(self.params[tree_id]), lines)
             model = models.get(tree_id)
             description = _description(model) if model is not None else ""
-            definition = BehaviorDef(tree_id, self.params[tree_id], description, tree, example if tree_id == main else {})
+            definition = BehaviorDef(
+                tree_id, self.params[tree_id], description, tree, example if tree_id == main else {}
+            )
             definitions[tree_id] = definition
             behaviors[tree_id] = self._behavior(definition, lines, trees[tree_id])
         if is_behavior:
             document = Document(header, None, definitions, self.xml.file)
+            complete(document, self.library)
             return ImportedXml(document, None, behaviors)
         lines = {key: value for key, value in header_lines.items()}
         lines[("tree",)] = trees[main].line
         tree = self.node(trees[main].children[0], ("tree",), frozenset(), lines)
         document = Document(header, tree, definitions, self.xml.file)
+        complete(document, self.library)
         source = YamlSource(self.xml.file, {**header, "tree": tree}, lines)
         return ImportedXml(document, source, behaviors)
 
@@ -149,7 +167,9 @@ class _Reader:
         main = self.xml.root.attrs.get("main_tree_to_execute") or "behaviour tree"
         return None, {"mission": main}, {}
 
-    def _params(self, tree_id: str, model: XmlElement | None, trees: dict[str, XmlElement]) -> dict[str, dict[str, Any]]:
+    def _params(
+        self, tree_id: str, model: XmlElement | None, trees: dict[str, XmlElement]
+    ) -> dict[str, dict[str, Any]]:
         """A subtree's parameters: its TreeNodesModel ports; without one, the ports its callers pass (any type)."""
         params: dict[str, dict[str, Any]] = {}
         if model is None:
@@ -201,12 +221,15 @@ class _Reader:
         else:
             node_id = tag
             if "ID" in attrs:
-                raise self.fail(element, f"<{tag}> takes no ID", hint=f"write <Action ID=\"{tag}\" …/> or <{tag} …/>")
+                raise self.fail(element, f"<{tag}> takes no ID", hint=f'write <Action ID="{tag}" …/> or <{tag} …/>')
         name = attrs.pop("name", None)
         for attribute in list(attrs):
             if attribute in SCRIPTED_ATTRIBUTES:
-                raise self.fail(element, f"{attribute}: BehaviorTree.CPP's scripted conditions are not read here",
-                                hint="use a check skill in a guard or fallback")
+                raise self.fail(
+                    element,
+                    f"{attribute}: BehaviorTree.CPP's scripted conditions are not read here",
+                    hint="use a check skill in a guard or fallback",
+                )
         if node_id in MISSION_NODE_IDS and node_id != "RoundRobin":
             return self._recovery(element, node_id, attrs, ypath, params, lines, name)
         lines[ypath] = element.line
@@ -272,9 +295,9 @@ class _Reader:
             fields = REGISTRY[node_id].params.model_fields
             body = {}
             for port, value in attrs.items():
-                if port.startswith("_"):
-                    raise self.fail(element, f"{node_id}: attribute {port} is not read here")
-                annotation = fields[port].annotation if port in fields else Any
+                if port not in fields:
+                    raise self.fail(element, f"{node_id}: unknown port '{port}'", hint=did_you_mean(port, fields))
+                annotation = fields[port].annotation
                 body[port] = decode(value, annotation, params)
                 lines[(*base, port)] = element.line
             return {node_id: body}
@@ -285,8 +308,11 @@ class _Reader:
                 hint="bt-export --no-wrappers writes the tree to read back; the compiler adds the wrappers again",
             )
         if node_id in UNSUPPORTED_BUILTINS:
-            raise self.fail(element, f"BehaviorTree.CPP's {node_id} has no counterpart here",
-                            hint=f"valid: {', '.join(STANDARD)}, RoundRobin, Recovery, RecoveryOrElse and the skills")
+            raise self.fail(
+                element,
+                f"BehaviorTree.CPP's {node_id} has no counterpart here",
+                hint=f"valid: {', '.join(STANDARD)}, RoundRobin, Recovery, RecoveryOrElse and the skills",
+            )
         if node_id in self.subtrees or node_id in self.library.behaviors:
             raise self.fail(element, f"'{node_id}' is a behaviour: call it as <SubTree ID=\"{node_id}\" …/>")
         options = [*STANDARD, *MISSION_NODE_IDS, *REGISTRY]
@@ -298,22 +324,29 @@ class _Reader:
         if attrs:
             raise self.fail(element, f"Parallel takes success_count and failure_count, got: {', '.join(attrs)}")
         if failure != "1":
-            raise self.fail(element, f"Parallel failure_count=\"{failure}\": here any failing child fails it",
-                            hint="valid: 1")
+            raise self.fail(
+                element, f'Parallel failure_count="{failure}": here any failing child fails it', hint="valid: 1"
+            )
         if success in ("-1", str(children)):
             return "all"
         if success == "1":
             return "one"
-        raise self.fail(element, f"Parallel success_count=\"{success}\"",
-                        hint=f"valid: -1 or {children} (all children) or 1 (the first to succeed)")
+        raise self.fail(
+            element,
+            f'Parallel success_count="{success}"',
+            hint=f"valid: -1 or {children} (all children) or 1 (the first to succeed)",
+        )
 
     def _decorator_value(self, element: XmlElement, node_id: str, port: str, value: str, params: frozenset[str]) -> Any:
         decoded = decode(value, int, params)
         if isinstance(decoded, str) and decoded.startswith("${") and node_id != "Timeout":
             return decoded  # a behaviour parameter, filled in where the behaviour is called
         if not isinstance(decoded, int):
-            raise self.fail(element, f"{node_id} {port}=\"{value}\": a whole number is needed",
-                            hint="blackboard entries {key} are not read by this decorator here")
+            raise self.fail(
+                element,
+                f'{node_id} {port}="{value}": a whole number is needed',
+                hint="blackboard entries {key} are not read by this decorator here",
+            )
         return decoded / 1000 if node_id == "Timeout" else decoded
 
     def _call(self, element, attrs, ypath, params, lines, at) -> dict:
@@ -321,7 +354,7 @@ class _Reader:
         if not tree_id:
             raise self.fail(element, "<SubTree> needs an ID")
         if element.children:
-            raise self.fail(element, f"<SubTree ID=\"{tree_id}\"> holds no child nodes")
+            raise self.fail(element, f'<SubTree ID="{tree_id}"> holds no child nodes')
         attrs.pop("_autoremap", None)  # behaviours share the one blackboard here: remapping is always on
         if tree_id in self.subtrees:
             declared = self.params[tree_id]
@@ -345,8 +378,11 @@ class _Reader:
         """Recovery (one child) or RecoveryOrElse (the node, then its alternative): the node's own ``recovery:``."""
         wanted = 1 if node_id == "Recovery" else 2
         if len(element.children) != wanted:
-            raise self.fail(element, f"{node_id} holds exactly {wanted} child node{'s' if wanted > 1 else ''}, "
-                                     f"found {len(element.children)}")
+            raise self.fail(
+                element,
+                f"{node_id} holds exactly {wanted} child node{'s' if wanted > 1 else ''}, "
+                f"found {len(element.children)}",
+            )
         if name is not None:
             raise self.fail(element, f"{node_id}: give the name to the node inside it")
         recovery: dict[str, Any] = {}

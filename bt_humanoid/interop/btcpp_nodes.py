@@ -30,13 +30,47 @@ TAG_DECORATORS = {tag: (kind, port, setting) for kind, (tag, port, setting) in D
 
 #: BehaviorTree.CPP's own node names that have no counterpart here (an import names them as such)
 UNSUPPORTED_BUILTINS = (
-    "AlwaysFailure AlwaysSuccess AsyncFallback AsyncSequence Delay IfThenElse KeepRunningUntilFailure LoopBool "
-    "LoopDouble LoopInt LoopString ParallelAll Precondition RunOnce Script ScriptCondition SetBlackboard "
-    "SkipUnlessUpdated Sleep Switch2 Switch3 Switch4 Switch5 Switch6 TryCatch UnsetBlackboard WaitValueUpdate "
-    "WasEntryUpdated WhileDoElse"
-).split()
+    "AlwaysFailure",
+    "AlwaysSuccess",
+    "AsyncFallback",
+    "AsyncSequence",
+    "Delay",
+    "IfThenElse",
+    "KeepRunningUntilFailure",
+    "LoopBool",
+    "LoopDouble",
+    "LoopInt",
+    "LoopString",
+    "ParallelAll",
+    "Precondition",
+    "RunOnce",
+    "Script",
+    "ScriptCondition",
+    "SetBlackboard",
+    "SkipUnlessUpdated",
+    "Sleep",
+    "Switch2",
+    "Switch3",
+    "Switch4",
+    "Switch5",
+    "Switch6",
+    "TryCatch",
+    "UnsetBlackboard",
+    "WaitValueUpdate",
+    "WasEntryUpdated",
+    "WhileDoElse",
+)
 #: attributes BehaviorTree.CPP gives every node (pre- and post-conditions in its script language): not read here
-SCRIPTED_ATTRIBUTES = ("_skipIf", "_while", "_successIf", "_failureIf", "_onSuccess", "_onFailure", "_post", "_onHalted")
+SCRIPTED_ATTRIBUTES = (
+    "_skipIf",
+    "_while",
+    "_successIf",
+    "_failureIf",
+    "_onSuccess",
+    "_onFailure",
+    "_post",
+    "_onHalted",
+)
 
 
 @dataclass(frozen=True)
@@ -80,9 +114,7 @@ WRAPPERS = (
         (),
         "halts its branch and fails on a stop request, collision, joint limit, workspace or time budget violation",
     ),
-    CustomNode(
-        "FaultWatch", "Decorator", (), "fails its skill on a dropped object, joint strain or lack of progress"
-    ),
+    CustomNode("FaultWatch", "Decorator", (), "fails its skill on a dropped object, joint strain or lack of progress"),
     CustomNode(
         "RecoveryRetry",
         "Decorator",
@@ -102,9 +134,7 @@ WRAPPERS = (
         "starts its sequence over when a node below that may replan failed",
     ),
     CustomNode("RecoveryAsk", "Decorator", (), "once all else failed, asks whether to try the child again"),
-    CustomNode(
-        "OrElse", "Control", (), "the first child (with its retries), or else the second, its alternative"
-    ),
+    CustomNode("OrElse", "Control", (), "the first child (with its retries), or else the second, its alternative"),
 )
 WRAPPER_IDS = {node.id for node in WRAPPERS}
 MISSION_NODE_IDS = {node.id: node for node in MISSION_NODES}
@@ -114,8 +144,7 @@ MISSION_NODE_IDS = {node.id: node for node in MISSION_NODES}
 SEMANTICS = {
     "Sequence": "Sequence: as BehaviorTree.CPP's (a running child is resumed, a failure starts it over next "
     "time); SequenceWithMemory is read as Sequence",
-    "Parallel": "Parallel: success_count -1 (all) or 1, failure_count 1; children that succeeded are not ticked "
-    "again",
+    "Parallel": "Parallel: success_count -1 (all) or 1, failure_count 1; children that succeeded are not ticked again",
     "Timeout": "Timeout: msec of simulation time, not wall-clock time",
     "RoundRobin": "RoundRobin: one child per run and its status (Nav2's moves on to the next child in the same "
     "tick when one fails)",

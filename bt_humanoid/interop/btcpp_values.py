@@ -102,8 +102,8 @@ def decode(text: str, annotation: Any, params: frozenset[str] = frozenset()) -> 
         return {"true": True, "false": False}.get(text.lower(), text)
     if base is int:
         return _number(text, int)
-    if base is float:
-        return _number(text, float)
+    if base is float:  # written 2: read 2, as YAML would (the live tree's labels show what was written)
+        return _number(text, int) if text.lstrip("-").isdigit() else _number(text, float)
     if origin in (tuple, list):
         return [decode(item.strip(), float, params) for item in text.split(";")]
     return _decode_any(_decode_text(text, params))
