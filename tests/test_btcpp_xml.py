@@ -234,6 +234,22 @@ def test_an_error_in_the_header_comment_names_the_file_line(tmp_path, capsys):
     assert "tree.xml:3: unknown world 'nowhere'" in error
 
 
+def test_a_yaml_error_in_the_header_comment_names_the_file_line(tmp_path, capsys):
+    text = "<!-- bt-humanoid mission\nmission: m\nsafety: {max_base_speed: [\n-->\n" + _tree('<wait seconds="1"/>')
+    error = _error(tmp_path, capsys, text)
+    assert "tree.xml:4: YAML syntax error" in error
+
+
+def test_bt_run_refuses_an_invalid_tree_before_any_physics(tmp_path, capsys):
+    from bt_humanoid.cli import run_main
+
+    file = tmp_path / "tree.xml"
+    file.write_text(_tree('<Sequence>\n<move_base place="atlantis"/>\n</Sequence>'))
+    assert run_main([str(file), "--no-live"]) == 2
+    error = " ".join(capsys.readouterr().err.split())
+    assert "tree.xml:4: move_base: unknown place 'atlantis'" in error
+
+
 # --- values ---------------------------------------------------------------------------------
 
 

@@ -158,12 +158,12 @@ class _Reader:
             mark = next((m for m in (MISSION_MARK, BEHAVIOR_MARK) if text.startswith(m)), None)
             if mark is None:
                 continue
-            body = text[len(mark) :]
-            source = read_yaml(self.xml.file, body)  # YAML errors: line within the comment, fixed below
+            # blank lines in front, so that the YAML's lines (and its syntax errors) are the file's
+            body = "\n" * (comment.line - 1) + text[len(mark) :]
+            source = read_yaml(self.xml.file, body)
             if not isinstance(source.data, dict):
                 raise self.fail(comment.line, f"the {mark} header is a YAML mapping")
-            offset = comment.line - 1
-            return mark, dict(source.data), {path: line + offset for path, line in source.lines.items()}
+            return mark, dict(source.data), dict(source.lines)
         main = self.xml.root.attrs.get("main_tree_to_execute") or "behaviour tree"
         return None, {"mission": main}, {}
 
