@@ -120,7 +120,9 @@ def run_main(argv: list[str] | None = None) -> int:
                 return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
             spec = outcome.spec
         else:
-            spec = MissionLoader(scene=args.scene, robot=args.robot).load_file(args.mission)
+            from bt_humanoid.interop.btcpp import load_mission  # YAML, or BehaviorTree.CPP XML
+
+            spec = load_mission(args.mission, MissionLoader(scene=args.scene, robot=args.robot))
             stack = stack_for(spec, args.seed, speak=speech)
         run = MissionRun(stack, spec, tick_hz=args.tick_hz)
         recorder = None
@@ -442,22 +444,10 @@ def validate_file(file: Path) -> str:
 
 
 def _validate_xml(file: Path) -> str:
-    """A BehaviorTree.CPP XML mission, or a behaviour (checked, as in YAML, in a throw-away mission)."""
-    from bt_humanoid.interop.btcpp_import import read_btcpp
-    from bt_humanoid.mission.behaviors import BehaviorLibrary
-    from bt_humanoid.mission.loader import MissionLoader
+    """A BehaviorTree.CPP XML mission or behaviour (bt_humanoid/interop/)."""
+    from bt_humanoid.interop.btcpp import check_xml
 
-    library = BehaviorLibrary()
-    imported = read_btcpp(file, library=library)
-    if imported.source is None:
-        name = imported.document.behavior
-        loader = MissionLoader(library=imported.library(library), check_world=False)
-        behavior = loader.library.behaviors[name]
-        loader.load_data({"mission": f"check {name}", "tree": {name: _default_args(behavior)}}, str(file))
-        return f"behaviour '{name}' (BehaviorTree.CPP XML)"
-    spec = MissionLoader().load_file(file)
-    count = sum(1 for _ in spec.tree.walk())
-    return f"mission '{spec.header.mission}' ({count} nodes, BehaviorTree.CPP XML)"
+    return check_xml(file)
 
 
 def _print_expanded(file: Path, console: Console) -> None:
@@ -467,7 +457,9 @@ def _print_expanded(file: Path, console: Console) -> None:
     from bt_humanoid.yaml_source import read_yaml
 
     if file.suffix.lower() == ".xml":
-        console.print(expand(MissionLoader().load_file(file)), markup=False)
+        from bt_humanoid.interop.btcpp import load_mission
+
+        console.print(expand(load_mission(file)), markup=False)
         return
     source = read_yaml(file)
     if isinstance(source.data, dict) and "behavior" in source.data:
@@ -477,13 +469,10 @@ def _print_expanded(file: Path, console: Console) -> None:
 
 
 def _default_args(behavior) -> dict:
-    """Arguments for checking a behaviour's tree on its own: its example, and a sample for any other required one."""
-    samples = {str: "x", float: 0.0, int: 0, bool: False}
-    args = {}
-    for name, field in behavior.args_model.model_fields.items():
-        if field.is_required():
-            args[name] = samples.get(field.annotation, "x")
-    return {**args, **behavior.example}
+    """Arguments for checking a behaviour's tree on its own (mission/behaviors.py)."""
+    from bt_humanoid.mission.behaviors import default_args
+
+    return default_args(behavior)
 
 
 def validate_main(argv: list[str] | None = None) -> int:

@@ -8,7 +8,7 @@ import pytest
 
 from bt_humanoid.cli import export_main, validate_main
 from bt_humanoid.engine.expand import expand
-from bt_humanoid.interop.btcpp import SCHEMA, compile_for_export, export_file
+from bt_humanoid.interop.btcpp import SCHEMA, compile_for_export, export_file, load_mission
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.paths import project_root
 from bt_humanoid.skills import REGISTRY
@@ -53,7 +53,7 @@ def test_an_imported_mission_compiles_to_the_tree_its_yaml_does(name, tmp_path):
     exported = tmp_path / "mission.xml"
     exported.write_text(export_file(file, wrappers=False)[0])
     # the same nodes, paths, wrappers and resolved recovery; a number written 2.0 is labelled 2 after the trip
-    same = [re.sub(r"\b(\d+)\.0\b", r"\1", expand(MissionLoader().load_file(f))) for f in (exported, file)]
+    same = [re.sub(r"\b(\d+)\.0\b", r"\1", expand(load_mission(f))) for f in (exported, file)]
     assert same[0] == same[1]
 
 
@@ -139,7 +139,7 @@ def test_the_hand_written_pick_and_place_validates(schema, capsys):
 
 
 def test_the_hand_written_tree_calls_library_behaviours_and_its_own_subtree():
-    spec = MissionLoader().load_file(EXAMPLE)
+    spec = load_mission(EXAMPLE)
     kinds = [node.kind for node in spec.tree.children]
     assert kinds == ["say", "sequence", "pick", "ToTheCounter", "place", "say"]
     assert spec.tree.children[3].name == "to the counter"

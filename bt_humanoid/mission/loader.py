@@ -9,7 +9,6 @@ as a UserError naming the place and what would be valid.
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, get_args
@@ -95,21 +94,6 @@ class MissionLoader:
     # --- entry points ------------------------------------------------------------
 
     def load_file(self, file: Path) -> MissionSpec:
-        """A mission YAML file, or a BehaviorTree.CPP v4 XML tree (``.xml``: Groot2's, or bt-export's)."""
-        if Path(file).suffix.lower() == ".xml":
-            # read into the same mission data, then validated like YAML (a late import: interop builds on this)
-            from bt_humanoid.interop.btcpp_import import read_btcpp
-
-            imported = read_btcpp(Path(file), library=self.library)
-            if imported.source is None:
-                raise UserError(
-                    f"behaviour '{imported.document.behavior}', not a mission",
-                    where=display_path(Path(file)),
-                    hint="call it from a mission with <SubTree ID=…/>",
-                )
-            loader = copy.copy(self)
-            loader.library = imported.library(self.library)
-            return loader.load_source(imported.source)
         return self.load_source(read_yaml(Path(file)))
 
     def load_text(self, text: str, name: str = "<mission>") -> MissionSpec:
