@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import copy
 from pathlib import Path
+from typing import Any
 
 from bt_humanoid.engine.compiler import CompiledMission, Compiler
 from bt_humanoid.errors import UserError
-from bt_humanoid.interop.btcpp_document import Document, document_from_yaml
+from bt_humanoid.interop.btcpp_document import Document, document_from_data, document_from_yaml
 from bt_humanoid.interop.btcpp_export import export_btcpp
 from bt_humanoid.interop.btcpp_import import ImportedXml, read_btcpp
 from bt_humanoid.mission.behaviors import BehaviorLibrary, default_args, load_behavior
@@ -62,6 +63,17 @@ def load_document(file: Path) -> tuple[Document, MissionSpec | None]:
         document = document_from_yaml(file, library)
     spec = load_mission(file, MissionLoader(library=library)) if document.behavior is None else None
     return document, spec
+
+
+def mission_document(mission: Path | dict[str, Any], library: BehaviorLibrary | None = None) -> Document:
+    """The Document of a mission already loaded: from its file (YAML or BehaviorTree.CPP XML), or from a plan's
+    data (a command's)."""
+    library = library or BehaviorLibrary()
+    if isinstance(mission, dict):
+        return document_from_data(mission, library)
+    if is_xml(mission):
+        return read_btcpp(Path(mission), library=library).document
+    return document_from_yaml(Path(mission), library)
 
 
 def compile_for_export(spec: MissionSpec) -> CompiledMission:

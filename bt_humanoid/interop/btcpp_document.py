@@ -62,12 +62,22 @@ def document_from_yaml(file: Path, library: BehaviorLibrary | None = None) -> Do
         document = Document(header, None, {main.name: main}, Path(file))
         _collect(main.tree, document, library, Path(file))
         return document
+    return document_from_data(data, library, Path(file))
+
+
+def document_from_data(
+    data: dict[str, Any], library: BehaviorLibrary | None = None, file: Path | None = None
+) -> Document:
+    """A mission given as data (already valid: a file's, or a planner's plan) as a Document, with every behaviour
+    it calls, transitively; ``subtree: {file}`` calls are found beside ``file`` (none: the working folder)."""
+    library = library or BehaviorLibrary()
+    base = file if file is not None else Path("<plan>")
     header = {key: value for key, value in data.items() if key != "tree"}
-    document = Document(header, data["tree"], {}, Path(file))
-    _collect(data["tree"], document, library, Path(file))
+    document = Document(header, data["tree"], {}, file)
+    _collect(data["tree"], document, library, base)
     for skill in (header.get("recovery") or {}).get("skills", {}).values():
         if isinstance(skill, dict) and skill.get("alternative") is not None:
-            _collect(skill["alternative"], document, library, Path(file))
+            _collect(skill["alternative"], document, library, base)
     return document
 
 

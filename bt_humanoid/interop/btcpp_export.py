@@ -66,6 +66,21 @@ def export_btcpp(document: Document, compiled: CompiledMission | None = None) ->
         raise UserError(f"cannot write as BehaviorTree.CPP XML: {error}", where=where) from None
 
 
+def compiled_elements(document: Document, compiled: CompiledMission) -> tuple[dict[str, El], list[El]]:
+    """The compiled form's trees (BehaviorTree ID → its root element; ``MAIN_TREE`` first) and its
+    TreeNodesModel, for writers of other forms of the same tree (Groot2's live tree, interop/groot2_tree.py).
+
+    A behaviour compiled the same way at each call is one tree here; its elements match each call's nodes.
+    """
+    exporter = _Exporter(document, compiled)
+    try:
+        exporter.write()
+        return exporter.trees, exporter._models()
+    except ValueError as error:
+        where = display_path(document.file) if document.file else None
+        raise UserError(f"cannot write as BehaviorTree.CPP XML: {error}", where=where) from None
+
+
 def kind_of(node: dict[str, Any]) -> str:
     return next(key for key in node if key not in NODE_EXTRAS)
 
