@@ -21,6 +21,7 @@ from bt_humanoid.paths import missions_dir
 
 EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
 SCHEMA_FILE = "mission.schema.json"
+GROOT_PORT = 1667  # Groot2's default (BehaviorTree.CPP's Groot2Publisher)
 
 
 def _fail_invalid(error: UserError) -> int:
@@ -66,6 +67,21 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument("--record", type=Path, help="write a video of the run (.mp4) from the scene camera")
     parser.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
     parser.add_argument("--tick-hz", type=float, default=20.0, help="tree tick rate in simulation time")
+    parser.add_argument(
+        "--groot",
+        nargs="?",
+        type=int,
+        const=GROOT_PORT,
+        metavar="PORT",
+        help=f"serve the tree and its statuses to Groot2 on PORT (default {GROOT_PORT}) and PORT + 1 while it runs "
+        "(needs pyzmq: docs/groot2.md)",
+    )
+    parser.add_argument(
+        "--rerun",
+        type=Path,
+        metavar="FILE.rrd",
+        help="record the run in 3-D for Rerun's viewer (needs rerun-sdk: docs/rerun.md)",
+    )
     return parser
 
 
@@ -99,8 +115,11 @@ def run_main(argv: list[str] | None = None) -> int:
         parser.error("give a mission file, --command TEXT, --audio FILE.wav, --interactive or --listen (one of them)")
     console = Console(soft_wrap=True)
     if args.interactive or args.listen:
+        if args.groot is not None or args.rerun is not None:
+            parser.error("--groot and --rerun watch one mission: give a mission file, --command or --audio")
         return _interactive(args, console)
     stack = None
+    watchers: list = []  # the Groot2 server and the Rerun recorder, when asked for: closed at the end
     try:
         from bt_humanoid.engine.runner import MissionRun, stack_for
         from bt_humanoid.engine.stack import RobotStack
@@ -108,9 +127,12 @@ def run_main(argv: list[str] | None = None) -> int:
 
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
+        _check_watchers(args)
         speech = _speech_out(args)
+        heard = None
         if args.audio is not None:
-            args.command = _heard_command(args, console)
+            args.command = heard = _heard_command(args, console)
+        plan = None
         if args.command is not None:
             # one robot from its first look to its last step: the plan comes from what this stack believes
             stack = RobotStack.load(args.world, _robot(args), args.seed or 0, speak=speech, scene=args.scene)
@@ -118,7 +140,7 @@ def run_main(argv: list[str] | None = None) -> int:
             if outcome.spec is None:
                 stack.close()
                 return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
-            spec = outcome.spec
+            spec, plan = outcome.spec, outcome.plan.mission
         else:
             from bt_humanoid.interop.btcpp import load_mission  # YAML, or BehaviorTree.CPP XML
 
@@ -131,7 +153,10 @@ def run_main(argv: list[str] | None = None) -> int:
 
             recorder = VideoRecorder(run.sim, args.record)
             stack.observers.append(recorder.capture)
+        _watch(args, run, plan, heard, watchers, console)
     except UserError as error:
+        for watcher in watchers:
+            watcher.close()
         if stack is not None:
             stack.close()
         return _fail_invalid(error)
@@ -160,6 +185,8 @@ def run_main(argv: list[str] | None = None) -> int:
             result = run.execute()
     finally:
         signal.signal(signal.SIGINT, previous)
+        for watcher in watchers:
+            watcher.close()
         stack.close()
         if recorder is not None:
             recorder.close()
@@ -171,6 +198,44 @@ def run_main(argv: list[str] | None = None) -> int:
     if args.events:
         result.events.write(args.events)
     return EXIT_OK if result.success else EXIT_FAILED
+
+
+def _check_watchers(args: argparse.Namespace) -> None:
+    """--groot and --rerun need their packages: say so before anything is loaded."""
+    if args.groot is not None:
+        from bt_humanoid.interop.groot2_server import import_zmq
+
+        import_zmq()
+    if args.rerun is not None:
+        from bt_humanoid.viz.rerun_recorder import import_rerun
+
+        import_rerun()
+
+
+def _watch(args: argparse.Namespace, run, plan: dict | None, heard: str | None, watchers: list, console: Console):
+    """Start what watches the run (``run``: a MissionRun): Groot2's monitor (--groot), Rerun's recording (--rerun).
+    Each goes into ``watchers`` as soon as it holds a resource, so that a failure after it still closes it."""
+    if args.rerun is not None:
+        import yaml
+
+        from bt_humanoid.viz.rerun_recorder import RerunRecorder
+
+        rerun = RerunRecorder(run.stack, args.rerun)
+        watchers.append(rerun)
+        if heard is not None:
+            rerun.note("heard", heard)
+        if plan is not None:
+            rerun.note("planned", yaml.safe_dump(plan, sort_keys=False, allow_unicode=True).rstrip())
+    if args.groot is not None:
+        from bt_humanoid.interop.btcpp import mission_document
+        from bt_humanoid.interop.groot2_server import Groot2Server
+        from bt_humanoid.interop.groot2_tree import groot2_tree
+
+        tree = groot2_tree(mission_document(plan if plan is not None else args.mission), run.compiled)
+        server = Groot2Server(tree, args.groot)
+        watchers.insert(0, server)  # closed first: the monitor goes before the recording is finished
+        run.executor.tick_listeners.append(server.snapshot)
+        console.print(f"Groot2: connect to port {args.groot} ({len(tree.nodes)} nodes)", highlight=False)
 
 
 def _robot(args: argparse.Namespace) -> str:
@@ -209,6 +274,8 @@ def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
     )
     if args.record:
         console.print(f"  video: {args.record}", highlight=False)
+    if args.rerun:
+        console.print(f"  rerun recording: {args.rerun}  (view it: rerun {args.rerun})", highlight=False)
 
 
 # --- commands: bt-plan, bt-run --command -----------------------------------------------
