@@ -33,7 +33,8 @@ from bt_humanoid.errors import UserError
 from bt_humanoid.perception.detector import Detection
 from bt_humanoid.perception.rgbd_camera import RgbdFrame
 from bt_humanoid.sim.geometry import object_extents
-from bt_humanoid.viz.rerun_scene import BodyPoses, log_geometry, xyzw
+from bt_humanoid.sim.simulation import Simulation
+from bt_humanoid.viz.rerun_scene import BodyPoses, entity_part, log_geometry, xyzw
 
 TIMELINE = "sim_time"
 INSTALL_HINT = "pip install 'bt-humanoid[rerun]' (rerun-sdk)"
@@ -50,6 +51,7 @@ MAP_SEEN_COLOUR = (200, 60, 200)
 MAP_HEIGHT = 0.01  # m above the floor the map's cells are drawn
 JPEG_QUALITY = 85
 MAX_DEPTH_MM = 65_535
+EYE_OFFSET = np.array([-2.2, -2.2, 2.6])  # m from the robot's start to where the 3-D view looks from
 
 
 def import_rerun() -> Any:
@@ -89,7 +91,7 @@ class RerunRecorder:
         self.rec = rr.RecordingStream("bt-humanoid")
         self.rec.set_log_time_enabled(False)  # the simulation clock is the timeline: no wall-clock stamps
         self.rec.set_log_tick_enabled(False)
-        self.rec.save(path)
+        self.rec.save(path, default_blueprint=default_layout(stack.sim))
         self.periods = {"pose": 1.0 / pose_rate, "belief": 1.0 / belief_rate, "map": 1.0 / map_rate}
         self.periods["flush"] = flush_period
         self.due = dict.fromkeys(self.periods, -math.inf)
@@ -183,6 +185,8 @@ class RerunRecorder:
                 "tree/status", rr.TextLog(f"{new:<8} {event['node']}{feedback}", level=STATUS_LEVELS.get(new, "INFO"))
             )
             node = self.rr.escape_entity_path_part(event["node"])
+            # the old status and the new one at the same moment: the plot steps instead of sloping
+            rec.log(f"tree/nodes/{node}", rr.Scalars(STATUS_CODES.get(event["old"], 0)))
             rec.log(f"tree/nodes/{node}", rr.Scalars(STATUS_CODES.get(new, 0)))
         elif kind == "say":
             rec.log("log/said", rr.TextLog(event["text"]))
@@ -318,6 +322,34 @@ class RerunRecorder:
         if goal.frame_task is not None:
             reference = goal.frame_task.target.translation
             rec.log("world/hands/reference", rr.Points3D([reference], colors=TARGET_COLOUR, radii=0.01))
+
+
+def default_layout(sim: Simulation) -> Any:
+    """What the viewer shows on opening a recording: the world in 3-D from behind and above the robot's start,
+    following it, beside the head camera, the tree's statuses over time and the log; the time panel on the
+    simulation clock."""
+    import rerun.blueprint as rrb
+
+    root = sim.model.body(sim.robot_root).id
+    start = sim.data.xpos[root]
+    eye = rrb.EyeControls3D(
+        position=start + EYE_OFFSET,
+        look_target=start + np.array([0.0, 0.0, 0.5]),
+        eye_up=[0.0, 0.0, 1.0],
+        tracking_entity=f"world/bodies/{entity_part(sim.robot_root)}",
+    )
+    world = rrb.Spatial3DView(origin="world", name="world (orange: belief, green: truth)", eye_controls=eye)
+    side = rrb.Vertical(
+        rrb.Spatial2DView(origin="world/head_camera", name="head camera"),
+        rrb.TimeSeriesView(origin="tree/nodes", name="tree: 0 idle, 1 running, 2 success, 3 failure"),
+        rrb.TextLogView(origin="/", contents=["tree/status", "log/**"], name="tree and words"),
+        row_shares=[2, 2, 2],
+    )
+    return rrb.Blueprint(
+        rrb.Horizontal(world, side, column_shares=[3, 2]),
+        rrb.TimePanel(timeline=TIMELINE),
+        collapse_panels=True,
+    )
 
 
 def _yaw_quaternion(yaw: float) -> np.ndarray:

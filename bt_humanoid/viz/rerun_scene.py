@@ -19,8 +19,9 @@ import numpy as np
 from bt_humanoid.sim.simulation import Simulation
 
 VISIBLE_GROUPS = 2  # geom groups 0–2 are drawn by MuJoCo's viewer by default; 3 and up are collision-only
-PLANE_HALF_SIZE = 10.0  # m: an infinite plane (size 0) is drawn this far each way
+PLANE_MARGIN = 1.0  # m an infinite plane (size 0) is drawn beyond the world's bounds
 PLANE_THICKNESS = 0.001  # m (half)
+FLOOR_GREY = 90
 
 
 def entity_part(name: str) -> str:
@@ -56,8 +57,9 @@ def log_geometry(rr: Any, rec: Any, sim: Simulation) -> None:
     for body in {body for body, _ in shapes} - moving:
         pose = rr.Transform3D(translation=data.xpos[body], quaternion=xyzw(data.xquat[body]))
         rec.log(paths[body], pose, static=True)
+    plane_half = float(np.max(np.abs(sim.world.bounds))) + PLANE_MARGIN  # the map, and a little beyond
     for (body, kind), geoms in sorted(shapes.items()):
-        for suffix, archetype in _archetypes(rr, model, kind, geoms):
+        for suffix, archetype in _archetypes(rr, model, kind, geoms, plane_half):
             rec.log(f"{paths[body]}/{suffix}", archetype, static=True)
 
 
@@ -66,8 +68,11 @@ def _colour(model: mujoco.MjModel, geom: int) -> np.ndarray:
     return model.mat_rgba[material] if material >= 0 else model.geom_rgba[geom]
 
 
-def _archetypes(rr: Any, model: mujoco.MjModel, kind: int, geoms: list[int]) -> list[tuple[str, Any]]:
-    """(entity suffix, archetype) for geoms of one type on one body, in the body's frame."""
+def _archetypes(
+    rr: Any, model: mujoco.MjModel, kind: int, geoms: list[int], plane_half: float
+) -> list[tuple[str, Any]]:
+    """(entity suffix, archetype) for geoms of one type on one body, in the body's frame; an infinite plane is
+    drawn ``plane_half`` metres each way."""
     centres = model.geom_pos[geoms]
     quats = xyzw(model.geom_quat[geoms])
     size = model.geom_size[geoms]
@@ -78,7 +83,8 @@ def _archetypes(rr: Any, model: mujoco.MjModel, kind: int, geoms: list[int]) -> 
         box = rr.Boxes3D(centers=centres, half_sizes=size, quaternions=quats, colors=colours, fill_mode=solid)
         return [("boxes", box)]
     if kind == geom_type.mjGEOM_PLANE:
-        half = np.where(size[:, :2] > 0, size[:, :2], PLANE_HALF_SIZE)
+        colours[:, :3] = FLOOR_GREY  # a plane's colour is mostly its texture's (a checker), which is not drawn
+        half = np.where(size[:, :2] > 0, size[:, :2], plane_half)
         halves = np.column_stack([half, np.full(len(geoms), PLANE_THICKNESS)])
         box = rr.Boxes3D(centers=centres, half_sizes=halves, quaternions=quats, colors=colours, fill_mode=solid)
         return [("planes", box)]
