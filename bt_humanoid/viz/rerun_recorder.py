@@ -85,7 +85,9 @@ class RerunRecorder:
             with path.open("wb"):
                 pass  # Rerun's file sink reports a bad path only on a background thread: try it here
         except OSError as error:
-            raise UserError(f"--rerun {path}: cannot write it: {error.strerror}") from None
+            parent = path.parent
+            reason = f"{parent} is not a folder" if parent.exists() and not parent.is_dir() else error.strerror
+            raise UserError(f"--rerun {path}: cannot write it: {reason}") from None
         self.rr, self.stack, self.path = rr, stack, path
         self.sim = stack.sim
         self.rec = rr.RecordingStream("bt-humanoid")
