@@ -9,6 +9,7 @@ import struct
 import subprocess
 import sys
 import threading
+import time
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -206,6 +207,7 @@ def test_bt_run_serves_the_tree_and_statuses_while_it_runs(tmp_path):
                     history = seen.setdefault(uid, [])
                     if not history or history[-1] != status:
                         history.append(status)
+                time.sleep(0.002)  # hundreds of polls a second: the turn's RUNNING cannot be missed
         except zmq.Again:
             pass  # the run ended and the server with it
         client.close()
