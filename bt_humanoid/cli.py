@@ -1,4 +1,4 @@
-"""Command-line entry points: bt-run, bt-plan and bt-validate.
+"""Command-line entry points: bt-run, bt-plan, bt-validate and bt-export.
 
 Exit codes: 0 success, 1 mission failed, 2 invalid input. A user error is one
 line on stderr naming the place and what would be valid; never a traceback.
@@ -21,6 +21,7 @@ from bt_humanoid.paths import missions_dir
 
 EXIT_OK, EXIT_FAILED, EXIT_INVALID = 0, 1, 2
 SCHEMA_FILE = "mission.schema.json"
+GROOT_PORT = 1667  # Groot2's default (BehaviorTree.CPP's Groot2Publisher)
 
 
 def _fail_invalid(error: UserError) -> int:
@@ -66,6 +67,21 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument("--record", type=Path, help="write a video of the run (.mp4) from the scene camera")
     parser.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
     parser.add_argument("--tick-hz", type=float, default=20.0, help="tree tick rate in simulation time")
+    parser.add_argument(
+        "--groot",
+        nargs="?",
+        type=int,
+        const=GROOT_PORT,
+        metavar="PORT",
+        help=f"serve the tree and its statuses to Groot2 on PORT (default {GROOT_PORT}) and PORT + 1 while it runs "
+        "(needs pyzmq: docs/groot2.md)",
+    )
+    parser.add_argument(
+        "--rerun",
+        type=Path,
+        metavar="FILE.rrd",
+        help="record the run in 3-D for Rerun's viewer (needs rerun-sdk: docs/rerun.md)",
+    )
     return parser
 
 
@@ -99,8 +115,11 @@ def run_main(argv: list[str] | None = None) -> int:
         parser.error("give a mission file, --command TEXT, --audio FILE.wav, --interactive or --listen (one of them)")
     console = Console(soft_wrap=True)
     if args.interactive or args.listen:
+        if args.groot is not None or args.rerun is not None:
+            parser.error("--groot and --rerun watch one mission: give a mission file, --command or --audio")
         return _interactive(args, console)
     stack = None
+    watchers: list = []  # the Groot2 server and the Rerun recorder, when asked for: closed at the end
     try:
         from bt_humanoid.engine.runner import MissionRun, stack_for
         from bt_humanoid.engine.stack import RobotStack
@@ -108,9 +127,12 @@ def run_main(argv: list[str] | None = None) -> int:
 
         if not 1.0 <= args.tick_hz <= 1000.0:
             raise UserError(f"--tick-hz {args.tick_hz}: out of range", hint="valid: 1 to 1000")
+        _check_watchers(args)
         speech = _speech_out(args)
+        heard = None
         if args.audio is not None:
-            args.command = _heard_command(args, console)
+            args.command = heard = _heard_command(args, console)
+        plan = None
         if args.command is not None:
             # one robot from its first look to its last step: the plan comes from what this stack believes
             stack = RobotStack.load(args.world, _robot(args), args.seed or 0, speak=speech, scene=args.scene)
@@ -118,9 +140,11 @@ def run_main(argv: list[str] | None = None) -> int:
             if outcome.spec is None:
                 stack.close()
                 return EXIT_OK if outcome.plan.kind == "stop" else EXIT_INVALID
-            spec = outcome.spec
+            spec, plan = outcome.spec, outcome.plan.mission
         else:
-            spec = MissionLoader(scene=args.scene, robot=args.robot).load_file(args.mission)
+            from bt_humanoid.interop.btcpp import load_mission  # YAML, or BehaviorTree.CPP XML
+
+            spec = load_mission(args.mission, MissionLoader(scene=args.scene, robot=args.robot))
             stack = stack_for(spec, args.seed, speak=speech)
         run = MissionRun(stack, spec, tick_hz=args.tick_hz)
         recorder = None
@@ -129,7 +153,10 @@ def run_main(argv: list[str] | None = None) -> int:
 
             recorder = VideoRecorder(run.sim, args.record)
             stack.observers.append(recorder.capture)
+        _watch(args, run, plan, heard, watchers, console)
     except UserError as error:
+        for watcher in watchers:
+            watcher.close()
         if stack is not None:
             stack.close()
         return _fail_invalid(error)
@@ -158,6 +185,8 @@ def run_main(argv: list[str] | None = None) -> int:
             result = run.execute()
     finally:
         signal.signal(signal.SIGINT, previous)
+        for watcher in watchers:
+            watcher.close()
         stack.close()
         if recorder is not None:
             recorder.close()
@@ -169,6 +198,44 @@ def run_main(argv: list[str] | None = None) -> int:
     if args.events:
         result.events.write(args.events)
     return EXIT_OK if result.success else EXIT_FAILED
+
+
+def _check_watchers(args: argparse.Namespace) -> None:
+    """--groot and --rerun need their packages: say so before anything is loaded."""
+    if args.groot is not None:
+        from bt_humanoid.interop.groot2_server import import_zmq
+
+        import_zmq()
+    if args.rerun is not None:
+        from bt_humanoid.viz.rerun_recorder import import_rerun
+
+        import_rerun()
+
+
+def _watch(args: argparse.Namespace, run, plan: dict | None, heard: str | None, watchers: list, console: Console):
+    """Start what watches the run (``run``: a MissionRun): Groot2's monitor (--groot), Rerun's recording (--rerun).
+    Each goes into ``watchers`` as soon as it holds a resource, so that a failure after it still closes it."""
+    if args.rerun is not None:
+        import yaml
+
+        from bt_humanoid.viz.rerun_recorder import RerunRecorder
+
+        rerun = RerunRecorder(run.stack, args.rerun)
+        watchers.append(rerun)
+        if heard is not None:
+            rerun.note("heard", heard)
+        if plan is not None:
+            rerun.note("planned", yaml.safe_dump(plan, sort_keys=False, allow_unicode=True).rstrip())
+    if args.groot is not None:
+        from bt_humanoid.interop.btcpp import mission_document
+        from bt_humanoid.interop.groot2_server import Groot2Server
+        from bt_humanoid.interop.groot2_tree import groot2_tree
+
+        tree = groot2_tree(mission_document(plan if plan is not None else args.mission), run.compiled)
+        server = Groot2Server(tree, args.groot)
+        watchers.insert(0, server)  # closed first: the monitor goes before the recording is finished
+        run.executor.tick_listeners.append(server.snapshot)
+        console.print(f"Groot2: connect to port {args.groot} ({len(tree.nodes)} nodes)", highlight=False)
 
 
 def _robot(args: argparse.Namespace) -> str:
@@ -207,6 +274,8 @@ def _print_summary(console: Console, result, args: argparse.Namespace) -> None:
     )
     if args.record:
         console.print(f"  video: {args.record}", highlight=False)
+    if args.rerun:
+        console.print(f"  rerun recording: {args.rerun}  (view it: rerun {args.rerun})", highlight=False)
 
 
 # --- commands: bt-plan, bt-run --command -----------------------------------------------
@@ -419,11 +488,14 @@ def mission_schema() -> dict:
 
 
 def validate_file(file: Path) -> str:
-    """Validate a mission or behaviour file; returns a one-line description, raises UserError."""
+    """Validate a mission or behaviour file (YAML, or BehaviorTree.CPP XML); returns a one-line description,
+    raises UserError."""
     from bt_humanoid.mission.behaviors import load_behavior
     from bt_humanoid.mission.loader import MissionLoader
     from bt_humanoid.yaml_source import read_yaml
 
+    if file.suffix.lower() == ".xml":
+        return _validate_xml(file)
     source = read_yaml(file)
     if isinstance(source.data, dict) and "behavior" in source.data:
         behavior = load_behavior(file)
@@ -438,12 +510,24 @@ def validate_file(file: Path) -> str:
     return f"mission '{spec.header.mission}' ({count} nodes)"
 
 
+def _validate_xml(file: Path) -> str:
+    """A BehaviorTree.CPP XML mission or behaviour (bt_humanoid/interop/)."""
+    from bt_humanoid.interop.btcpp import check_xml
+
+    return check_xml(file)
+
+
 def _print_expanded(file: Path, console: Console) -> None:
     """The mission in ``file`` as it will run (a behaviour has no robot or world to resolve against)."""
     from bt_humanoid.engine.expand import expand
     from bt_humanoid.mission.loader import MissionLoader
     from bt_humanoid.yaml_source import read_yaml
 
+    if file.suffix.lower() == ".xml":
+        from bt_humanoid.interop.btcpp import load_mission
+
+        console.print(expand(load_mission(file)), markup=False)
+        return
     source = read_yaml(file)
     if isinstance(source.data, dict) and "behavior" in source.data:
         console.print("  (a behaviour: --expand shows missions; call it from one to see it expanded)")
@@ -452,13 +536,10 @@ def _print_expanded(file: Path, console: Console) -> None:
 
 
 def _default_args(behavior) -> dict:
-    """Arguments for checking a behaviour's tree on its own: its example, and a sample for any other required one."""
-    samples = {str: "x", float: 0.0, int: 0, bool: False}
-    args = {}
-    for name, field in behavior.args_model.model_fields.items():
-        if field.is_required():
-            args[name] = samples.get(field.annotation, "x")
-    return {**args, **behavior.example}
+    """Arguments for checking a behaviour's tree on its own (mission/behaviors.py)."""
+    from bt_humanoid.mission.behaviors import default_args
+
+    return default_args(behavior)
 
 
 def validate_main(argv: list[str] | None = None) -> int:
@@ -482,6 +563,45 @@ def validate_main(argv: list[str] | None = None) -> int:
                 _print_expanded(file, console)
     except UserError as error:
         return _fail_invalid(error)
+    return EXIT_OK
+
+
+# --- bt-export ----------------------------------------------------------------------------
+
+
+def _export_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="bt-export",
+        description="Write a mission or behaviour as BehaviorTree.CPP v4 XML (for Groot2, Nav2 and BehaviorTree.CPP).",
+    )
+    parser.add_argument("file", type=Path, help="mission or behaviour YAML file (or BehaviorTree.CPP XML, rewritten)")
+    parser.add_argument("-o", "--output", type=Path, metavar="FILE.xml", help="write here (default: stdout)")
+    parser.add_argument(
+        "--no-wrappers",
+        action="store_true",
+        help="the mission's own tree, without the safety and recovery wrappers the compiler adds: the form "
+        "bt-run and bt-validate read back",
+    )
+    return parser
+
+
+def export_main(argv: list[str] | None = None) -> int:
+    args = _export_parser().parse_args(argv)
+    console = Console(highlight=False, soft_wrap=True, stderr=True)
+    try:
+        from bt_humanoid.interop.btcpp import export_file
+
+        text, note = export_file(args.file, wrappers=not args.no_wrappers)
+    except UserError as error:
+        return _fail_invalid(error)
+    if note:
+        console.print(note)
+    if args.output is None:
+        sys.stdout.write(text)
+    else:
+        args.output.parent.mkdir(parents=True, exist_ok=True)
+        args.output.write_text(text)
+        console.print(f"wrote {args.output}")
     return EXIT_OK
 
 

@@ -25,6 +25,7 @@ LAYERS = {
     "engine": 8,
     "docs": 8,
     "viz": 9,
+    "interop": 9,
     "commanding": 10,
     "testing": 11,
     "training": 11,

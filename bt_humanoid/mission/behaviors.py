@@ -91,6 +91,16 @@ class BehaviorLibrary:
         return {name: b.args_model for name, b in self.behaviors.items()}
 
 
+def default_args(behavior: Behavior) -> dict[str, Any]:
+    """Arguments for checking a behaviour's tree on its own: its example, and a sample for any other required one."""
+    samples = {str: "x", float: 0.0, int: 0, bool: False}
+    args = {}
+    for name, spec in behavior.args_model.model_fields.items():
+        if spec.is_required():
+            args[name] = samples.get(spec.annotation, "x")
+    return {**args, **behavior.example}
+
+
 def substitute(value: Any, args: dict[str, Any], source: YamlSource, path: tuple) -> Any:
     """Replace ``${param}`` in a behaviour's tree with the call's arguments."""
     if isinstance(value, dict):

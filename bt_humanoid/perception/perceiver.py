@@ -47,6 +47,8 @@ class Perceiver:
         self.learned = LearnedDetector.for_world(sim.world) if sim.world.detector is not None else None
         self.frames = 0
         self.look_times: list[float] = []  # wall seconds per look (capture, detection, fusion), for benchmarks
+        #: called after each look with its frame and detections (a recorder), the WorldModel already updated
+        self.look_listeners: list[Callable[[RgbdFrame, list[Detection]], None]] = []
 
     def step(self) -> None:
         if self.sim.time - self.last_look >= self.period - 1e-9:
@@ -75,6 +77,8 @@ class Perceiver:
         integrate(belief, detections, frame)
         self.frames += 1
         self.look_times.append(time.perf_counter() - started)
+        for listener in self.look_listeners:
+            listener(frame, detections)
         return detections
 
     def _mask_robot(self, frame: RgbdFrame) -> None:

@@ -8,6 +8,7 @@ from typing import Any
 
 from bt_humanoid.engine.runner import MissionRun, RunResult
 from bt_humanoid.engine.stack import RobotStack
+from bt_humanoid.interop.btcpp import load_mission as load_file
 from bt_humanoid.mission.loader import MissionLoader
 from bt_humanoid.mission.spec import MissionSpec
 from bt_humanoid.sim.ground_truth import GroundTruth
@@ -46,8 +47,10 @@ def load_mission(mission: str | Path | dict) -> MissionSpec:
     loader = MissionLoader()
     if isinstance(mission, dict):
         return loader.load_data(mission)
-    if isinstance(mission, Path) or (isinstance(mission, str) and mission.endswith(".yaml") and "\n" not in mission):
-        return loader.load_file(Path(mission))
+    if isinstance(mission, Path) or (
+        isinstance(mission, str) and mission.endswith((".yaml", ".xml")) and "\n" not in mission
+    ):
+        return load_file(Path(mission), loader)  # a mission file: YAML, or BehaviorTree.CPP XML
     return loader.load_text(mission)
 
 
