@@ -109,7 +109,8 @@ def main(argv: list[str] | None = None) -> None:
             for mode in MODES:
                 figures = one_run(args.mission, mode, args.seed, Path(folder))
                 results[mode].append(figures)
-                print(f"run {index + 1} {mode:<6} real-time factor {figures['rtf']:5.2f}×", flush=True)
+                outcome = "" if figures["success"] else ", the mission FAILED"
+                print(f"run {index + 1} {mode:<6} real-time factor {figures['rtf']:5.2f}×{outcome}", flush=True)
     plain = statistics.median(r["rtf"] for r in results["plain"])
     summary = {"mission": str(args.mission), "runs": args.runs, "poll_hz": POLL_HZ, "modes": {}}
     print(f"\n{args.mission}: median of {args.runs} runs each")
