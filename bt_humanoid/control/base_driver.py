@@ -75,6 +75,9 @@ class BaseDriver(SpeedMonitoring):
     def speeds(self) -> np.ndarray:
         return self.io.velocities().copy()
 
+    def settled(self) -> bool:
+        return True  # the planar joints stop where they are
+
     def move_to(
         self, x: float, y: float, yaw: float, max_speed: float | None = None, shortest_turn: bool = True
     ) -> MotionHandle:

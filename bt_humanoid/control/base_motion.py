@@ -31,6 +31,11 @@ class BaseMotion(Protocol):
         """(vx, vy, yaw rate) in the world frame."""
         ...
 
+    def settled(self) -> bool:
+        """Whether the pose read now is where the base stays if it stops: a wheeled base's always is; a walking
+        base's only once it stands, its pelvis no longer swaying over each stance foot."""
+        ...
+
     def capped(self, requested: float | None = None) -> float:
         """The speed a motion may plan for: what it asks under the mission's cap and the base's limit."""
         ...

@@ -176,7 +176,9 @@ class RouteFollower:
         if route.length - s > END_EPSILON or abs(speed) > 1e-3:
             return
         tolerance = self.config.tolerance
-        if remaining < tolerance.position and math.degrees(yaw_error) < tolerance.yaw_deg:
+        arrived = remaining < tolerance.position and math.degrees(yaw_error) < tolerance.yaw_deg
+        # a walking base is there once it stands: arriving mid-step, its swaying pelvis ended up to 13 cm off
+        if arrived and self.base.settled():
             handle.succeed(f"arrived within {remaining * 100:.1f} cm, {math.degrees(yaw_error):.1f}°")
             self.handle = None
             self.route = None
@@ -186,6 +188,8 @@ class RouteFollower:
         self.started_settling = self.started_settling if self.started_settling is not None else now
         # a slow base (a biped turning at 0.3 rad/s, a step at a time) gets the time its last turn takes as well
         settle = SETTLE_TIMEOUT + abs(wrap_angle(route.goal_yaw - pose[2])) / self.config.limits.max_yaw_rate
+        if arrived:  # within tolerance and coming to rest: as long again for its last steps
+            settle *= 2
         if now - self.started_settling > settle:
             handle.fail(f"stopped {remaining:.2f} m and {math.degrees(yaw_error):.0f}° from the goal")
             self.handle = None

@@ -83,6 +83,10 @@ class WalkingBase(SpeedMonitoring):
         assert state is not None
         return np.array([state.linear_velocity[0], state.linear_velocity[1], state.angular_velocity[2]])
 
+    def settled(self) -> bool:
+        """Standing after the last step, the centre of mass come to rest over the middle of the feet."""
+        return self.walker.phase is Phase.STANDING and float(np.hypot(*self.speeds()[:2])) < SETTLED_SPEED
+
     def capped(self, requested: float | None = None) -> float:
         return min(requested if requested is not None else math.inf, self.speed_cap, self.config.limits.max_speed)
 
@@ -165,9 +169,8 @@ class WalkingBase(SpeedMonitoring):
         yaw_error = abs(math.degrees(remaining_turn))
         handle.feedback = f"{error:.2f} m to go, heading off by {yaw_error:.0f}°"
         # standing, and settled: the centre of mass comes to rest over the middle of the feet after the last step
-        standing = self.walker.phase is Phase.STANDING and float(np.hypot(*self.speeds()[:2])) < SETTLED_SPEED
         tolerance = self.config.tolerance
-        if standing and error < tolerance.position and yaw_error < tolerance.yaw_deg:
+        if self.settled() and error < tolerance.position and yaw_error < tolerance.yaw_deg:
             handle.succeed(f"arrived within {error * 100:.1f} cm, {yaw_error:.1f}°")
             self.handle = None
             self.target = None
