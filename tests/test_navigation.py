@@ -9,9 +9,11 @@ from py_trees.common import Status
 
 from bt_humanoid.cli import run_main
 from bt_humanoid.engine.composites import RoundRobin
+from bt_humanoid.navigation.follower import RouteFollower
 from bt_humanoid.navigation.navigator import OBSERVED_MEMORY
 from bt_humanoid.navigation.occupancy import OccupancyGrid
-from bt_humanoid.navigation.planner import Clearance, PlanError, plan_route
+from bt_humanoid.navigation.planner import SAMPLE_SPACING, Clearance, PlanError, Route, plan_route
+from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.testing.scenario import Scenario, build_run
 
 PLACES = {"table": (2.4, 0.0), "counter": (7.75, 2.5), "shelf": (1.2, 3.45), "kitchen": (7.0, 2.4)}
@@ -97,6 +99,28 @@ class _Crawl:
 
     def describe(self) -> str:
         return "a person close by"
+
+
+def straight_route(length: float, goal_yaw: float) -> Route:
+    points = np.stack([np.arange(0.0, length + 1e-9, SAMPLE_SPACING), np.zeros(int(length / SAMPLE_SPACING) + 1)], 1)
+    arc = points[:, 0].copy()
+    return Route(points, arc, np.zeros(len(arc)), goal_yaw, 0.0)
+
+
+@pytest.mark.parametrize("robot", ["biped_humanoid", "wheeled_humanoid"])
+def test_a_base_that_turns_before_it_walks_slows_to_end_its_last_turn_with_the_route(robot):
+    config = load_robot_config(robot).base
+    follower = RouteFollower(None, config, 0.02)  # the speed cap reads no base
+    follower.max_speed = config.limits.max_speed
+    route = straight_route(3.0, math.pi / 2)  # a quarter turn to make at the end of a straight route
+    far, near = (follower._speed_cap(route, s, 0.0, 0.0) for s in (0.5, route.length - 0.3))
+    assert far == pytest.approx(config.limits.max_speed)
+    if config.limits.turn_first is None:  # a wheeled base turns as it drives, at any speed
+        assert near == pytest.approx(config.limits.max_speed)
+    else:  # 0.3 m at the speed that takes as long as 90° at the yaw rate
+        assert near == pytest.approx(0.3 * config.limits.max_yaw_rate / (math.pi / 2))
+        turned = follower._speed_cap(route, route.length - 0.3, 0.0, math.pi / 2 - 0.01)  # the turn nearly made
+        assert turned == pytest.approx(config.limits.max_speed)
 
 
 @pytest.mark.sim

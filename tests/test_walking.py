@@ -19,7 +19,7 @@ from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.world_config import load_world_config
-from bt_humanoid.testing.scenario import run_scenario
+from bt_humanoid.testing.scenario import build_run, run_scenario
 
 pytestmark = pytest.mark.sim
 
@@ -164,6 +164,28 @@ def test_a_base_motion_mission_runs_on_the_biped():
     )
     assert scenario.result.success, scenario.result.cause
     assert not any("_sole_" not in mine for mine, _ in scenario.run.truth.robot_contacts())
+
+
+def test_the_biped_arriving_with_a_last_turn_to_make_keeps_clear_of_the_table():
+    """The navigation benchmark's apartment run 46: arriving at 0.26 m/s with 60° still to turn, the pelvis ran
+    on 18 cm past the stance and the right forearm touched the table; the route follower now slows for it."""
+    run = build_run(
+        {
+            "mission": "walk to the table",
+            "world": "apartment",
+            "robot": "biped_humanoid",
+            "tree": {"navigate": {"place": "table", "speed": 0.8}},
+        },
+        robot_start=(4.384, -1.812, 61.9),
+    )
+    touched: set[tuple[str, str]] = set()
+    run.executor.observers.append(
+        lambda: touched.update((mine, other) for mine, other in run.truth.robot_contacts() if "_sole_" not in mine)
+    )
+    result = run.execute()
+    run.stack.close()
+    assert result.success, result.cause
+    assert not touched
 
 
 def test_a_fall_is_caught_by_the_robots_own_sensors_and_leaves_the_legs_limp():

@@ -103,7 +103,8 @@ class RouteFollower:
             self.handle = None
             self.stop()
             return
-        speed_cap = min(self._speed_cap(route, s, float(inp.current_velocity[0])), share * self.max_speed)
+        speed = float(inp.current_velocity[0])
+        speed_cap = min(self._speed_cap(route, s, speed, float(inp.current_position[1])), share * self.max_speed)
         yaw = self._heading_target(route, s, index)
         if limits.turn_first is not None and abs(wrap_angle(yaw - self.base.pose()[2])) > limits.turn_first:
             speed_cap = 0.0  # face the way first: the route's reference waits while the base turns
@@ -111,7 +112,6 @@ class RouteFollower:
         end = route.length if self.stop_at is None else min(route.length, max(s, self.stop_at - STOP_SHORT))
         # while held to a crawl (someone close), a far end would take longer than a trajectory can last: aim no
         # further than the crawl covers in HORIZON seconds, beyond the braking distance (re-aimed every step)
-        speed = float(inp.current_velocity[0])
         end = min(end, s + speed**2 / (2 * limits.max_accel) + HORIZON * inp.max_velocity[0])
         inp.target_position = [end, float(inp.current_position[1]) + wrap_angle(yaw - inp.current_position[1])]
         inp.target_velocity = [0.0, 0.0]
@@ -133,17 +133,29 @@ class RouteFollower:
 
     # ------------------------------------------------------------------ internals
 
-    def _speed_cap(self, route: Route, s: float, speed: float) -> float:
-        """The fastest speed from which every bend within braking distance can still be taken."""
+    def _speed_cap(self, route: Route, s: float, speed: float, yaw: float) -> float:
+        """The fastest speed from which every bend within braking distance can still be taken (and, for a base
+        that turns before it walks, the last turn finished by the end of the route)."""
         limits = self.config.limits
         horizon = s + speed**2 / (2 * limits.max_accel) + 0.3
         window = (route.arc_length >= s) & (route.arc_length <= horizon)
         kappa = float(route.curvature[window].max()) if np.any(window) else 0.0
         cap = math.sqrt(LATERAL_ACCEL / kappa) if kappa > 1e-6 else self.max_speed
+        if limits.turn_first is not None:
+            cap = min(cap, self._final_turn_cap(route, s, yaw))
         if self.stop_at is not None:  # something ahead: slow so the base can stop short of it
             room = max(self.stop_at - STOP_SHORT - s, 0.0)
             cap = min(cap, math.sqrt(2 * limits.max_accel * room))
         return max(min(cap, self.max_speed, self.speed_limit), 0.05)
+
+    def _final_turn_cap(self, route: Route, s: float, yaw: float) -> float:
+        """A walking base takes up a streamed velocity a step late: arriving fast and still turning to the goal's
+        yaw, its pelvis ran on 18 cm past the end (into a table). The speed at which the rest of the route takes
+        as long as the turn still to make (at the base's yaw rate) lets the turn end as the route does."""
+        to_go = route.length - s
+        heading = yaw if to_go < FINAL_STRETCH else route.heading(len(route.points) - 1)
+        turn = abs(wrap_angle(route.goal_yaw - heading))
+        return to_go * self.config.limits.max_yaw_rate / turn if turn > 1e-6 else math.inf
 
     def _heading_target(self, route: Route, s: float, index: int) -> float:
         if route.length - s < FINAL_STRETCH or route.length < 1e-6:
