@@ -153,3 +153,19 @@ def test_retargeting_mid_swing_keeps_the_path_smooth_and_lands_sooner_where_aske
         assert b == pytest.approx(a, abs=1e-9)
     pose, velocity, _ = swing.at(0.45)
     assert pose == pytest.approx([0.3, 0.1, -PRESS, 0.2]) and velocity == pytest.approx(np.zeros(4), abs=1e-9)
+
+
+def test_a_swing_retimed_just_after_lift_off_still_rises_to_the_step_height_before_it_lands():
+    """A push at lift-off asks the foot to land sooner; a path straight down from there dragged the sole across
+    the floor and the recovery step fell 17 cm short."""
+    swing = SwingTrajectory(np.zeros(4), np.array([0.0, -0.3, 0.0, 0.0]), 0.6, height=0.05)
+    before = swing.at(0.01)
+    swing.retarget(0.01, np.array([0.0, -0.45, 0.0]), 0.25)
+    after = swing.at(0.01)
+    for a, b in zip(before, after, strict=True):  # position, velocity, acceleration carry on
+        assert b == pytest.approx(a, abs=1e-9)
+    heights = [swing.at(t)[0][2] for t in np.linspace(0.01, 0.25, 49)]
+    assert max(heights) == pytest.approx(0.05, abs=0.002)
+    assert swing.at(0.125)[0][2] == pytest.approx(0.05, abs=1e-6)  # at the top half-way through the new swing
+    pose, velocity, _ = swing.at(0.25)
+    assert pose == pytest.approx([0.0, -0.45, -PRESS, 0.0]) and velocity == pytest.approx(np.zeros(4), abs=1e-9)

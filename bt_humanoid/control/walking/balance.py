@@ -25,6 +25,7 @@ from bt_humanoid.control.wbc.dynamics import RobotDynamics
 from bt_humanoid.control.wbc.id_limits import HeldJointLimit, JointLimit, TorqueLimit
 from bt_humanoid.control.wbc.id_solver import IdSolution, solve_id
 from bt_humanoid.control.wbc.id_tasks import ComTask, JointPostureTask, OrientationTask
+from bt_humanoid.sim.robot_config import LEG_ROLES
 from bt_humanoid.sim.robot_io import MujocoRobotIO
 from bt_humanoid.sim.scene_config import start_pose
 from bt_humanoid.sim.simulation import Simulation
@@ -52,6 +53,9 @@ LEG_POSTURE_GAINS = (10.0, 6.0)
 # trajectories plan under); a servo is not a motor, and the QP does not drive it faster than its plans do
 SERVO_SPEED_MARGIN = 1.5
 HELD_JOINTS_GAIN = 10.0
+# rad the QP keeps each knee bent at the least. A straight leg is singular: its foot cannot be lifted (a stance leg
+# pushed sideways straightened to its stop, and the recovery step that followed dragged its sole along the floor)
+LEAST_KNEE_BEND = 0.15
 # A fall, by the robot's own sensors: the pelvis (the IMU) tilted further than this from upright, or lower than
 # this above the feet (standing it is 0.52 m up). Walking tilts it a few degrees; no recovery comes back from 30°.
 MAX_TILT_DEG = 30.0
@@ -105,6 +109,8 @@ class BalanceController:
         controlled = self.legs + self.servoed
         model = sim.model
         ranges = np.array([model.jnt_range[model.joint(j).id] for j in controlled])
+        knees = [controlled.index(leg.joints[LEG_ROLES.index("knee")]) for leg in (legs.left, legs.right)]
+        ranges[knees, 0] = np.maximum(ranges[knees, 0], LEAST_KNEE_BEND)
         speeds = np.array(
             [
                 legs.speed_limit(j) if j in legs.joints else SERVO_SPEED_MARGIN * config.motion_limits(j).velocity

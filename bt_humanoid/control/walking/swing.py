@@ -5,7 +5,8 @@ peaks at h half-way and starts and lands with zero velocity and acceleration. Ac
 quintic from rest to rest; it waits for the foot to clear the floor and ends before it lands (``LIFT_SHARE`` of
 the phase each side), so the sole neither scuffs nor slides in. ``retarget`` moves the footstep mid-swing (step
 adjustment): a new quintic from where the path is now, with its velocity and acceleration, to the new footstep
-by the same time, so the reference stays smooth.
+by the same time, so the reference stays smooth. A new landing time re-plans the height as well: up to the full
+step height by half the new swing if the foot is not that high yet, then down to the floor.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ class SwingTrajectory:
         self.duration = duration
         self.height = height
         self._across_start = LIFT_SHARE * duration  # s when the move across begins
-        self._descent: tuple[float, Quintic] | None = None  # (from when, the height's path) once retimed
+        self._vertical: list[tuple[float, Quintic]] = []  # once retimed: the height's path, (from when, quintic)
         zero = np.zeros(3)
         self._across = Quintic((1 - 2 * LIFT_SHARE) * duration, self.start[[0, 1, 3]], zero, zero, self.end[[0, 1, 3]])
 
@@ -77,11 +78,9 @@ class SwingTrajectory:
         self.end[[0, 1]] = end[:2]
         self.end[3] = self.start[3] + math.remainder(float(end[2]) - self.start[3], 2 * math.pi)
         if duration is not None and abs(duration - self.duration) > 1e-9:
-            # a new landing time: down from where the foot is now, by a quintic to the floor
-            z, vz, az = (float(value[2]) for value in self.at(t))
-            descent = Quintic(max(duration - t, 1e-3), *(np.array([x]) for x in (z, vz, az, self.end[2] - PRESS)))
-            self._descent = (t, descent)
-            self.duration = duration
+            self._retime_height(t, duration)
+            if t <= self._across_start:  # a shorter swing clears the floor sooner: it may move across sooner too
+                self._across_start = max(t, LIFT_SHARE * duration)
         finish = self.duration - min(LIFT_SHARE * self.duration, (self.duration - t) / 3)
         if t <= self._across_start:  # not moving across yet: the same path, to the new place
             zero = np.zeros(3)
@@ -99,9 +98,9 @@ class SwingTrajectory:
         s = min(max(t / T, 0.0), 1.0)
         across = self._across.at(t - self._across_start)
         pose, velocity, acceleration = (np.array([q[0], q[1], 0.0, q[2]]) for q in across)
-        if self._descent is not None and t >= self._descent[0]:  # retimed: straight down to the floor
-            start, descent = self._descent
-            z = descent.at(t - start)
+        if self._vertical and t >= self._vertical[0][0]:  # retimed: the height's own path
+            start, segment = next((s, q) for s, q in reversed(self._vertical) if t >= s)
+            z = segment.at(t - start)
             pose[2], velocity[2], acceleration[2] = z[0][0], z[1][0], z[2][0]
             return pose, velocity, acceleration
         # up and down: h·64 s³(1 − s)³ above the line between the two heights, pressing a little at the end
@@ -113,3 +112,20 @@ class SwingTrajectory:
             rise * press_second + 64 * h * (6 * s * (1 - s) ** 3 - 18 * s**2 * (1 - s) ** 2 + 6 * s**3 * (1 - s))
         ) / T**2
         return pose, velocity, acceleration
+
+    def _retime_height(self, t: float, duration: float) -> None:
+        """The height's path from ``t`` for a swing that now lands ``duration`` s after lift-off: a foot that has
+        not yet risen to the step height does (by half the new swing, at the soonest now) before coming down;
+        going straight down from just after lift-off dragged the sole across the floor, and the step fell short."""
+        z, vz, az = (np.array([float(value[2])]) for value in self.at(t))
+        floor = np.array([self.end[2] - PRESS])
+        top = np.array([max(self.start[2], self.end[2]) + self.height])
+        apex = max(duration / 2, t)
+        if z[0] < top[0] - 1e-3 and vz[0] >= 0.0 and apex - t > 1e-3 and duration - apex > 1e-3:
+            self._vertical = [
+                (t, Quintic(apex - t, z, vz, az, top)),
+                (apex, Quintic(duration - apex, top, *[np.zeros(1)] * 2, floor)),
+            ]
+        else:
+            self._vertical = [(t, Quintic(max(duration - t, 1e-3), z, vz, az, floor))]
+        self.duration = duration
