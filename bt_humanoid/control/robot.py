@@ -61,10 +61,12 @@ class RobotController:
         self.grippers = GripperController(self.joints, self.config.grippers)
         io = self.body_io
         ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
-        #: whole-body motions (reaching, gaze) over a planar base; a walking robot has none yet (docs/walking.md)
-        self.whole_body: WholeBodyController | None = None
+        #: whole-body motions (reaching, gaze): over a planar base, or a walking robot's upper body
         self.feedforward: BaseAccelerationFeedforward | None = None
-        if isinstance(self.base, BaseDriver):
+        if self.walking is not None:
+            dynamics = self.walking.walker.dynamics
+            self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges, lambda: dynamics.q)
+        else:
             self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
             self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, self.config.base.planar_joints)
         self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
@@ -74,8 +76,7 @@ class RobotController:
     def set_control_period(self, period: float) -> None:
         """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""
         self.control_period = period
-        if self.whole_body is not None:
-            self.whole_body.dt = period
+        self.whole_body.dt = period
 
     def monitor_separation(self, separation: Separation) -> None:
         """Slow the base near people and things it senses (``separation.share`` limits every base motion)."""
@@ -88,8 +89,7 @@ class RobotController:
             self.separation.update(base_pose[:2])
         for planner in self.planners:
             planner.step()
-        if self.whole_body is not None:
-            self.whole_body.step()  # streams references first, the controllers below then track them
+        self.whole_body.step()  # streams references first, the controllers below then track them
         self.base.step()
         if self.feedforward is not None:
             acceleration = self.base.acceleration  # type: ignore[attr-defined]
@@ -106,17 +106,13 @@ class RobotController:
         """Halt every motion: base and joints decelerate to rest under their limits."""
         for planner in self.planners:
             planner.halt()
-        if self.whole_body is not None:
-            self.whole_body.cancel()
+        self.whole_body.cancel()
         self.base.brake()
         self.joints.brake()
 
     def frame_position(self, frame: str) -> np.ndarray:
         """Where a frame of the robot's model is (world), from the encoders and odometry."""
-        if self.whole_body is not None:
-            return self.whole_body.frame_pose(frame).translation.copy()
-        assert self.walking is not None
-        return self.walking.walker.dynamics.pose(frame).translation.copy()
+        return self.whole_body.frame_pose(frame).translation.copy()
 
     def hand_position(self, side: str) -> np.ndarray:
         """Where the ``side`` gripper's grip point is (world)."""

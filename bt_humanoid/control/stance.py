@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from bt_humanoid.perception.world_model import SupportSurface
+from bt_humanoid.sim.robot_config import BaseConfig
 
 EDGE_CLEARANCE = 0.05  # m between the footprint and the surface edge
 HAND_LATERAL = 0.18  # m: the working hand reaches this far to its side of the base centre line
@@ -29,14 +30,19 @@ def stance_for(
     footprint_radius: float,
     bounds: np.ndarray,
     robot_xy: np.ndarray,
+    standoff: float | None = None,
+    max_depth: float = MAX_DEPTH,
+    hand_lateral: float = HAND_LATERAL,
 ) -> tuple[float, float, float]:
-    """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``.
+    """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``: ``standoff`` m from
+    the edge (default: the footprint ``EDGE_CLEARANCE`` clear of it), the spot at most ``max_depth`` behind it
+    and ``hand_lateral`` to the working hand's side.
 
     Of the edges that reach the spot, the one whose stance is nearest the robot wins.
     """
     (x0, y0), (x1, y1) = surface.region
     x, y = float(spot[0]), float(spot[1])
-    standoff = footprint_radius + EDGE_CLEARANCE
+    standoff = footprint_radius + EDGE_CLEARANCE if standoff is None else standoff
     # (depth of the spot behind the edge, stance position on the line through the spot, facing yaw)
     edges = [
         (x - x0, np.array([x0 - standoff, y]), 0.0),
@@ -44,7 +50,7 @@ def stance_for(
         (y - y0, np.array([x, y0 - standoff]), math.pi / 2),
         (y1 - y, np.array([x, y1 + standoff]), -math.pi / 2),
     ]
-    lateral = HAND_LATERAL if side == "right" else -HAND_LATERAL
+    lateral = hand_lateral if side == "right" else -hand_lateral
     options = []
     for depth, position, yaw in edges:
         left = np.array([-math.sin(yaw), math.cos(yaw)])
@@ -54,14 +60,32 @@ def stance_for(
             options.append((depth, stance, yaw))
     if not options:
         raise StanceError(f"no room to stand beside the {surface.name}")
-    reachable = [option for option in options if option[0] <= MAX_DEPTH]
+    reachable = [option for option in options if option[0] <= max_depth]
     if reachable:
         depth, stance, yaw = min(reachable, key=lambda option: float(np.linalg.norm(option[1] - robot_xy)))
     else:
         depth, stance, yaw = min(options, key=lambda option: option[0])
-    if depth > MAX_DEPTH:
+    if depth > max_depth:
         raise StanceError(
             f"spot ({x:.2f}, {y:.2f}) is {depth:.2f} m behind the nearest free edge of the {surface.name}; "
-            f"the arm reaches {MAX_DEPTH:.2f} m"
+            f"the arm reaches {max_depth:.2f} m"
         )
     return float(stance[0]), float(stance[1]), yaw
+
+
+def working_stance(
+    spot: np.ndarray, surface: SupportSurface, side: str, base: BaseConfig, bounds: np.ndarray, robot_xy: np.ndarray
+) -> tuple[float, float, float]:
+    """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml)."""
+    stance = base.working_stance
+    return stance_for(
+        spot,
+        surface,
+        side,
+        base.footprint_radius,
+        bounds,
+        robot_xy,
+        standoff=stance.standoff,
+        max_depth=stance.reach_depth,
+        hand_lateral=stance.hand_lateral,
+    )

@@ -6,12 +6,19 @@ QP at its reference configuration, integrates the step into new references
 and streams them to the joint position controllers and the base driver.
 Completion is judged on the measured configuration (the encoders), so a hand
 held back by contact does not count as arrived.
+
+On a walking robot the pelvis and legs are the walking controller's: the QP
+moves the upper body only (waist, arms, head), from where the state estimator
+and the leg encoders put the pelvis, and its references become the posture
+targets of the walker's inverse-dynamics QP, where balance weighs more. The
+robot steps to where it works (stance planning); its hands do not pull it there.
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,11 +83,18 @@ class WholeBodyController:
         base: BaseMotion,
         joints: JointReferenceController,
         joint_ranges: dict[str, tuple[float, float]],
+        floating_state: Callable[[], np.ndarray] | None = None,
     ) -> None:
         self.config = config
         self.base = base
         self.joints = joints
-        self.base_joints = [config.base.joints[axis] for axis in ("x", "y", "yaw")]
+        #: the planar base's x, y and yaw, which the QP moves with the body; none on a walking robot
+        self.base_joints = config.base.planar_joints
+        #: a walking robot's whole configuration as its walker estimates it (Pinocchio's q): the pelvis and legs
+        #: the upper body stands on
+        self.floating_state = floating_state
+        if config.base.floating and floating_state is None:
+            raise ValueError(f"robot '{config.name}' walks: give its walker's estimated configuration")
         body_joints = [j for group in config.groups.values() for j in group]
         self.names = self.base_joints + body_joints
         self.kinematics = RobotKinematics(config, self.names)  # at the reference configuration
@@ -89,10 +103,8 @@ class WholeBodyController:
         lower = np.array([joint_ranges.get(j, (-np.inf, np.inf))[0] for j in self.names])
         upper = np.array([joint_ranges.get(j, (-np.inf, np.inf))[1] for j in self.names])
         limits = config.base.limits
-        max_velocity = np.array(
-            [limits.max_speed, limits.max_speed, limits.max_yaw_rate]
-            + [config.motion_limits(j).velocity for j in body_joints]
-        )
+        base_speeds = [limits.max_speed, limits.max_speed, limits.max_yaw_rate] if self.base_joints else []
+        max_velocity = np.array(base_speeds + [config.motion_limits(j).velocity for j in body_joints])
         self.position_limit = JointPositionLimit(lower, upper)
         self.max_velocity = max_velocity
         margins = {g.grip_site: HAND_TORSO_MARGIN for g in config.grippers.values()}
@@ -110,11 +122,11 @@ class WholeBodyController:
     # ------------------------------------------------------------------ queries
 
     def measured_positions(self) -> np.ndarray:
-        return np.concatenate([self.base.pose(), self.joints.io.positions()[self._body_index]])
+        return np.concatenate([self._base_pose(), self.joints.io.positions()[self._body_index]])
 
     def frame_pose(self, frame: str) -> pin.SE3:
         """Where a frame is now, from the encoders."""
-        self.measured.update(self.measured_positions())
+        self._update(self.measured, self.measured_positions())
         return self.measured.pose(frame).copy()
 
     def hand_frame(self, side: str) -> str:
@@ -142,7 +154,7 @@ class WholeBodyController:
         """
         self._begin()
         frame = self.hand_frame(side)
-        self.kinematics.update(self.reference)
+        self._update(self.kinematics, self.reference)
         start = self.kinematics.pose(frame).copy()
         distance = float(np.linalg.norm(target.translation - start.translation))
         angle = float(np.linalg.norm(pin.log3(target.rotation @ start.rotation.T)))
@@ -172,7 +184,8 @@ class WholeBodyController:
             tasks.append(gaze_task)
         else:
             tasks.append(PostureTask({j: self.reference[self.names.index(j)] for j in self._head_joints()}, 1.0))
-        tasks.append(DampingTask(self.base_joints, BASE_WEIGHT))
+        if self.base_joints:
+            tasks.append(DampingTask(self.base_joints, BASE_WEIGHT))
         frozen = [] if move_base else self.base_joints
         handle = MotionHandle(f"reaching {distance * 100:.0f} cm with the {side} hand", on_cancel=self._cancelled)
         self.goal = WholeBodyGoal(
@@ -224,8 +237,9 @@ class WholeBodyController:
             goal.frame_task.target = pin.SE3.Interpolate(goal.start_pose, goal.target_pose, s)
         # the base is velocity-controlled and gets pushed by the arms' reactions: solve at its measured pose
         # (odometry) so the hand lands where it should in the world; the base itself tracks base_target
-        self.reference[:3] = self.base.pose()
-        self.kinematics.update(self.reference)
+        base = len(self.base_joints)
+        self.reference[:base] = self._base_pose()
+        self._update(self.kinematics, self.reference)
         solution = solve_ik(self.kinematics, goal.tasks, goal.box_limits, goal.limits, self.dt)
         self.solve_times.append(solution.solve_time)
         self.conic_times.append(solution.conic_time)
@@ -234,10 +248,11 @@ class WholeBodyController:
             self._finish(goal, False, "whole-body QP has no solution: the target breaks a joint or safety limit")
             return
         self.reference = self.reference + solution.step
-        self.base_target = self.base_target + solution.step[:3]
         velocity = solution.step / self.dt
-        self.base.track(self.base_target, velocity[:3])
-        self.joints.track(self._body_index, self.reference[3:], velocity[3:])
+        if self.base_joints:
+            self.base_target = self.base_target + solution.step[:3]
+            self.base.track(self.base_target, velocity[:3])
+        self.joints.track(self._body_index, self.reference[base:], velocity[base:])
         self._check_done(goal, elapsed)
 
     # ------------------------------------------------------------------ internals
@@ -246,8 +261,8 @@ class WholeBodyController:
         if self.goal is not None:
             self.goal.handle.fail("pre-empted by a newer goal")
             self.goal = None
-        self.reference = np.concatenate([self.base.pose(), self.joints.position[self._body_index]])
-        self.base_target = self.reference[:3].copy()
+        self.reference = np.concatenate([self._base_pose(), self.joints.position[self._body_index]])
+        self.base_target = self.base.pose()
 
     def _box_limits(self, frozen: list[str]) -> list[BoxLimit]:
         """Position and velocity bounds for one goal; ``frozen`` joints get a zero speed limit."""
@@ -256,18 +271,18 @@ class WholeBodyController:
 
     def _check_done(self, goal: WholeBodyGoal, elapsed: float) -> None:
         if goal.stop_on_contact and goal.frame_task is not None:
-            self.measured.update(self.measured_positions())
+            self._update(self.measured, self.measured_positions())
             frame = goal.frame_task.frame
             lag = self.kinematics.pose(frame).translation - self.measured.pose(frame).translation
             if np.linalg.norm(lag) > CONTACT_LAG:
                 self.reference = self.measured_positions()  # stop pressing
-                self.base_target = self.reference[:3].copy()
+                self.base_target = self.base.pose()
                 self._finish(goal, True, "stopped on contact")
                 return
         if elapsed < goal.duration:
             goal.handle.feedback = f"{goal.handle.description}: {elapsed:.1f}/{goal.duration:.1f} s"
             return
-        self.measured.update(self.measured_positions())
+        self._update(self.measured, self.measured_positions())
         if goal.frame_task is not None:
             error = goal.frame_task.error(self.measured)
             goal.position_error = float(np.linalg.norm(error[:3]))
@@ -287,7 +302,8 @@ class WholeBodyController:
 
     def _finish(self, goal: WholeBodyGoal, success: bool, message: str) -> None:
         self.goal = None
-        self.base.track(self.base_target, np.zeros(3))
+        if self.base_joints:
+            self.base.track(self.base_target, np.zeros(3))
         if success:
             goal.handle.succeed(message)
         else:
@@ -296,8 +312,20 @@ class WholeBodyController:
     def _cancelled(self, handle: MotionHandle) -> None:
         if self.goal is not None and self.goal.handle is handle:
             self.goal = None
-            self.base.brake()
+            if self.base_joints:  # the base moved with the goal (a walking robot's steps are the walker's)
+                self.base.brake()
             self.joints.brake(self._body_index)
+
+    def _base_pose(self) -> np.ndarray:
+        """The planar base's x, y, yaw by odometry; nothing on a walking robot."""
+        return self.base.pose() if self.base_joints else np.zeros(0)
+
+    def _update(self, kinematics: RobotKinematics, positions: np.ndarray) -> None:
+        """Kinematics at ``positions`` of the controlled joints; on a walking robot, standing where its walker
+        estimates the pelvis and its legs are."""
+        if self.floating_state is not None:
+            kinematics.q[:] = self.floating_state()
+        kinematics.update(positions)
 
     def _arm_joints(self, side: str) -> list[str]:
         group = f"{side}_arm"

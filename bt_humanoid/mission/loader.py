@@ -240,15 +240,6 @@ class MissionLoader:
     def _skill(self, kind, body, source, bpath, node_path, spec) -> NodeSpec:
         info = REGISTRY[kind]
         params = validate_params(info.params, body, source, bpath, prefix=f"{kind}: ")
-        robot = self.checks.robot_config
-        if info.behaviour.needs_whole_body and robot.base.floating:
-            movable = sorted(k for k, i in REGISTRY.items() if not i.behaviour.needs_whole_body)
-            raise UserError(
-                f"{kind}: robot '{robot.name}' walks but cannot reach or look at things yet (whole-body motion on "
-                "legs is docs/walking.md's next step)",
-                where=source.where(bpath),
-                hint=f"on it a mission may use: {', '.join(movable)}",
-            )
         raw = dict(body or {})
         if self.check_world and not any(is_reference(v) for v in raw.values()):
             for parameter, message in info.behaviour.check(params, self.checks):

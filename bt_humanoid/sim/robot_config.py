@@ -40,6 +40,20 @@ class BaseTolerance(StrictModel):
 PLANAR_AXES = ("x", "y", "yaw")
 
 
+class WorkingStance(StrictModel):
+    """Where the base stands to work on a spot of a surface (control/stance.py): facing the nearest edge, the spot
+    in front of the working hand. The defaults are the wheeled robot's, whose base and lift help every reach."""
+
+    standoff: float | None = Field(
+        None,
+        gt=0,
+        description="m from the surface's edge to the base's centre; default: the footprint 5 cm clear of the edge "
+        "(a walking robot's feet take less room than its footprint)",
+    )
+    reach_depth: float = Field(0.42, gt=0, description="m behind the edge the hand reaches from the stance")
+    hand_lateral: float = Field(0.18, ge=0, description="m to its side of the base's centre line the spot lies")
+
+
 class BaseConfig(StrictModel):
     """How the robot's base moves: planar joints driven by actuators (a wheeled base), or a floating base (a free
     joint nothing drives: the legs carry it)."""
@@ -48,6 +62,7 @@ class BaseConfig(StrictModel):
     joints: dict[str, str] = Field(description="planar: {x, y, yaw: joint}; floating: {free: the free joint}")
     actuators: dict[str, str] = Field(description="planar: {x, y, yaw: actuator}; floating: none ({})")
     footprint_radius: float = 0.3
+    working_stance: WorkingStance = WorkingStance()
     limits: BaseLimits = BaseLimits()
     tolerance: BaseTolerance = BaseTolerance()
 

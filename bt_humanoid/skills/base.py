@@ -32,9 +32,6 @@ class Skill(py_trees.behaviour.Behaviour):
     #: a skill that moves the robot succeeds once the robot has come to rest (up to SETTLE_LIMIT after its
     #: motion ended): a tree never reports done while an arm still swings or the base still rolls
     settles: ClassVar[bool] = False
-    #: a skill that moves the hands or the head by whole-body motion (``robot.whole_body``): a robot without one
-    #: (the walking biped, for now) cannot run it, and a mission that asks is refused when it loads
-    needs_whole_body: ClassVar[bool] = False
 
     def __init__(self, name: str, raw_params: dict[str, Any], context: SkillContext, path: str) -> None:
         super().__init__(name=name)

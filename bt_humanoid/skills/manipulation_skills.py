@@ -24,7 +24,7 @@ from bt_humanoid.control.keep_clear import (
     transit_height,
 )
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.control.stance import StanceError, stance_for
+from bt_humanoid.control.stance import StanceError, working_stance
 from bt_humanoid.control.wbc.limits import BaseBoundsLimit, BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
 from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
 from bt_humanoid.perception.free_space import EDGE_MARGIN, MAX_SHIFT, nearest_free
@@ -79,8 +79,6 @@ def lift_what_is_held(context: SkillContext) -> MotionHandle | None:
 
 class _ManipulationSkill(PhasedSkill):
     """Shared helpers: reach limits, the carry pose."""
-
-    needs_whole_body = True
 
     def _keepout(self, region: np.ndarray) -> list[Limit]:
         """Keep the base's footprint off a rectangle of the floor ([[x0, y0], [x1, y1]]: furniture reached over)
@@ -205,6 +203,7 @@ class StandNearParams(StrictModel):
 
 
 STANCE_ARRIVAL = 0.15  # m: the first and last stretch at a stance may graze the map's margin round furniture
+APPROACH_BACKOFF = 0.3  # m behind a stance, at most, where navigation may end before the straight last stretch
 
 
 # a stance not reached is tried once more (an arm settles, a passer-by moves on), then from a fresh look
@@ -227,6 +226,7 @@ class StandNear(_ManipulationSkill):
             ("tuck the other arm", self._tuck),
             ("raise the arm", self._raise_arm),
             ("hand up", self._hand_up),
+            ("approach", self._approach),
             ("stance", self._drive),
         ]
 
@@ -269,11 +269,11 @@ class StandNear(_ManipulationSkill):
             spot = np.array(p.at) if p.at is not None else surface.region.mean(axis=0)
         config = self.context.robot_config
         try:
-            pose = stance_for(
+            pose = working_stance(
                 spot,
                 surface,
                 p.side,
-                config.base.footprint_radius,
+                config.base,
                 np.array(self.context.world.bounds),
                 self.context.robot.base.pose()[:2],
             )
@@ -288,6 +288,24 @@ class StandNear(_ManipulationSkill):
         joints = config.groups.get(f"{other}_arm", [])
         tucked = config.postures.get(TUCKED_POSTURE, {})
         return self.context.robot.joints.move({j: tucked[j] for j in joints if j in tucked})
+
+    def _approach(self) -> MotionHandle | None:
+        """Where furniture stands between the robot and the stance, navigate round it first: to the stance, or
+        as near it, straight behind it, as leaves the footprint room (a walking robot works nearer a table than
+        its footprint keeps from furniture). The last stretch is then straight (``_drive``)."""
+        p: StandNearParams = self.params
+        if p.object is not None and self._object(p.object).held_by is not None:
+            return None
+        _surface, (x, y, yaw) = self._stance()
+        navigator = self.context.navigator
+        if navigator is None or not self._straight_way_blocked(np.array([x, y])):
+            return None
+        back = np.array([math.cos(yaw), math.sin(yaw)])
+        steps = np.arange(0.0, APPROACH_BACKOFF + 1e-9, navigator.grid.resolution)
+        options = np.array([x, y]) - steps[:, None] * back
+        fits = np.flatnonzero(navigator.grid.clearance_at(options) >= navigator.clearance.minimum)
+        x, y = options[fits[0]] if fits.size else options[-1]
+        return navigator.go_to(np.array([x, y, yaw]), p.max_speed)
 
     def _drive(self) -> MotionHandle | None:
         p: StandNearParams = self.params

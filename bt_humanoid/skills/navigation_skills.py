@@ -14,7 +14,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.control.stance import StanceError, stance_for
+from bt_humanoid.control.stance import StanceError, working_stance
 from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE, lift_what_is_held
 from bt_humanoid.skills.params import check_in_map, check_name, check_object
@@ -181,9 +181,8 @@ class NavigateTo(_BaseSkill):
         surface = belief.surface_under(obj.position) if obj.held_by is None else None
         if surface is not None:
             bounds = np.array(self.context.world.bounds)
-            radius = config.base.footprint_radius
             try:
-                x, y, yaw = stance_for(obj.position[:2], surface, "right", radius, bounds, here[:2])
+                x, y, yaw = working_stance(obj.position[:2], surface, "right", config.base, bounds, here[:2])
             except StanceError as error:
                 raise PhaseFailure(str(error)) from None
             # a step back from the working stance: room to raise the arms before the last approach (stand_near),

@@ -86,6 +86,14 @@ class BalanceController:
         stance = standing_posture(config, posture=posture)
         self.com_height = float(stance.com[2])  # above the soles
         self.omega = math.sqrt(self.dynamics.gravity / self.com_height)
+        # the torso lift raises everything above it: the centre of mass by that share of the lift's travel, which
+        # the height's target follows (else the knees would bend to hold the centre of mass where it was)
+        model = self.dynamics.model
+        data = model.createData()
+        pin.computeSubtreeMasses(model, data)
+        lifts = [j for j in config.groups.get("lift", []) if j in self.dynamics.joints]
+        self._lift_q = np.array([self.dynamics.joint_index(j) + 1 for j in lifts], dtype=int)
+        self._lift_share = np.array([data.mass[model.getJointId(j)] / data.mass[0] for j in lifts])
 
         # who drives what: leg motors take torques; the upper body's servos take targets; the torso lift and the
         # fingers stay with their own servos (the lift at its stop, the grippers to the gripper controller)
@@ -258,7 +266,8 @@ class BalanceController:
         self.zmp_command = zmp
         acceleration = np.zeros(3)
         acceleration[:2] = omega**2 * (com[:2] - zmp)
-        self.com.set_target(np.array([com[0], com[1], floor + self.com_height]), acceleration=acceleration)
+        height = self.com_height + float(self._lift_share @ dynamics.q[self._lift_q])
+        self.com.set_target(np.array([com[0], com[1], floor + height]), acceleration=acceleration)
         upright = pin.rpy.rpyToMatrix(0.0, 0.0, yaw)
         self.pelvis.target = upright
         self.torso.target = upright
