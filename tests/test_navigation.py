@@ -107,20 +107,42 @@ def straight_route(length: float, goal_yaw: float) -> Route:
     return Route(points, arc, np.zeros(len(arc)), goal_yaw, 0.0)
 
 
+class _Facing:
+    """A base standing at the origin facing ``yaw``: all the speed cap reads of one."""
+
+    def __init__(self, yaw: float) -> None:
+        self.yaw = yaw
+
+    def pose(self) -> np.ndarray:
+        return np.array([0.0, 0.0, self.yaw])
+
+
 @pytest.mark.parametrize("robot", ["biped_humanoid", "wheeled_humanoid"])
-def test_a_base_that_turns_before_it_walks_slows_to_end_its_last_turn_with_the_route(robot):
+def test_a_base_that_turns_before_it_walks_slows_for_its_last_turn_and_to_side_step(robot):
     config = load_robot_config(robot).base
-    follower = RouteFollower(None, config, 0.02)  # the speed cap reads no base
+    follower = RouteFollower(_Facing(0.0), config, 0.02)
     follower.max_speed = config.limits.max_speed
     route = straight_route(3.0, math.pi / 2)  # a quarter turn to make at the end of a straight route
-    far, near = (follower._speed_cap(route, s, 0.0, 0.0) for s in (0.5, route.length - 0.3))
+
+    def cap(s: float, yaw: float) -> float:  # the base facing where its reference does
+        follower.base = _Facing(yaw)
+        return follower._speed_cap(route, s, 0.0, yaw)
+
+    far, near = cap(0.5, 0.0), cap(route.length - 0.3, 0.0)
     assert far == pytest.approx(config.limits.max_speed)
     if config.limits.turn_first is None:  # a wheeled base turns as it drives, at any speed
         assert near == pytest.approx(config.limits.max_speed)
+        assert cap(0.5, math.pi / 2) == pytest.approx(config.limits.max_speed)  # and drives sideways as fast
     else:  # 0.3 m at the speed that takes as long as 90° at the yaw rate
         assert near == pytest.approx(0.3 * config.limits.max_yaw_rate / (math.pi / 2))
-        turned = follower._speed_cap(route, route.length - 0.3, 0.0, math.pi / 2 - 0.01)  # the turn nearly made
-        assert turned == pytest.approx(config.limits.max_speed)
+        # the turn made, the route runs to the base's side: as fast as it side-steps
+        turned = cap(route.length - 0.3, math.pi / 2 - 0.01)
+        assert turned == pytest.approx(config.limits.max_sideways_speed, rel=1e-3)
+        # facing 45° off the route: on the ellipse of its forward and sideways speeds
+        half = math.sqrt(0.5)
+        assert cap(0.5, math.pi / 4) == pytest.approx(
+            1 / math.hypot(half / config.limits.max_speed, half / config.limits.max_sideways_speed)
+        )
 
 
 @pytest.mark.sim

@@ -27,7 +27,13 @@ def _pin_worker(cores: list[int], counter) -> None:
 
 
 def run_local(
-    suite_file: str, indices: list[int], seed: int, workers: int, scene: str | None = None, plan_only: bool = False
+    suite_file: str,
+    indices: list[int],
+    seed: int,
+    workers: int,
+    scene: str | None = None,
+    plan_only: bool = False,
+    robot: str | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Episodes in ``workers`` processes (spawned: each has its own MuJoCo and renderers), or in this one."""
     cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
@@ -36,7 +42,7 @@ def run_local(
             if cores:
                 os.sched_setaffinity(0, {cores[0]})
             for index in indices:
-                yield run_episode(suite_file, index, seed, scene=scene, plan_only=plan_only)
+                yield run_episode(suite_file, index, seed, scene=scene, plan_only=plan_only, robot=robot)
         finally:
             if cores:
                 os.sched_setaffinity(0, set(cores))
@@ -44,7 +50,9 @@ def run_local(
     context = multiprocessing.get_context("spawn")
     counter = context.Value("i", 0)
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_pin_worker, initargs=(cores, counter)) as pool:
-        futures = [pool.submit(run_episode, suite_file, index, seed, None, scene, plan_only) for index in indices]
+        futures = [
+            pool.submit(run_episode, suite_file, index, seed, None, scene, plan_only, robot) for index in indices
+        ]
         for future in as_completed(futures):
             yield future.result()
 
@@ -56,6 +64,7 @@ def run_ray(
     address: str | None,
     scene: str | None = None,
     plan_only: bool = False,
+    robot: str | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Episodes as Ray tasks, one CPU each, on the cluster at ``address`` (or a local Ray instance)."""
     try:
@@ -67,7 +76,7 @@ def run_ray(
     if not ray.is_initialized():
         ray.init(address=address, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
     remote = ray.remote(num_cpus=1)(run_episode)
-    pending = [remote.remote(suite_file, index, seed, None, scene, plan_only) for index in indices]
+    pending = [remote.remote(suite_file, index, seed, None, scene, plan_only, robot) for index in indices]
     while pending:
         finished, pending = ray.wait(pending, num_returns=1)
         yield ray.get(finished[0])

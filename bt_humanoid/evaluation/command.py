@@ -39,6 +39,7 @@ def _parser() -> _Parser:
         action="store_true",
         help="household suites: plan each instruction and judge the plan, run nothing in physics (seconds, not hours)",
     )
+    parser.add_argument("--robot", help="the robot episodes run on, a folder of robots/ (default: the suite's)")
     parser.add_argument("--family", help="household suites: only the instructions of this family")
     parser.add_argument("--workers", type=int, default=1, help="worker processes, one core each (default 1)")
     parser.add_argument("--backend", choices=["local", "ray"], default="local", help="where episodes run")
@@ -67,7 +68,7 @@ def eval_main(argv: list[str] | None = None) -> int:
         if args.seed is not None and args.seed < 0:
             raise UserError(f"--seed {args.seed}: give 0 or more")
         file = _suite_file(args.suite)
-        suite, _ = load_suite(file, args.scene)
+        suite, _ = load_suite(file, args.scene, args.robot)
         if args.scene is not None:
             args.scene = suite.scene  # a file's path made absolute: the workers may start elsewhere
         episodes = min(args.episodes or suite.episodes, len(suite.instructions) or 10**9)
@@ -138,9 +139,9 @@ def _run(file: str, indices: list[int], seed: int, args, console: Console) -> tu
     from bt_humanoid.evaluation.backends import run_local, run_ray
 
     stream = (
-        run_ray(file, indices, seed, args.address, args.scene, args.plan_only)
+        run_ray(file, indices, seed, args.address, args.scene, args.plan_only, args.robot)
         if args.backend == "ray"
-        else run_local(file, indices, seed, args.workers, args.scene, args.plan_only)
+        else run_local(file, indices, seed, args.workers, args.scene, args.plan_only, args.robot)
     )
     records: list[dict[str, Any]] = []
     started = time.perf_counter()

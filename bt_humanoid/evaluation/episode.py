@@ -35,8 +35,8 @@ from bt_humanoid.testing.spots import nudge, reachable_spot
 
 
 @cache
-def _suite(path: str, scene: str | None = None) -> Suite:
-    return load_suite(Path(path), scene)[0]
+def _suite(path: str, scene: str | None = None, robot: str | None = None) -> Suite:
+    return load_suite(Path(path), scene, robot)[0]
 
 
 @cache
@@ -79,14 +79,15 @@ def run_episode(
     events: list[dict[str, Any]] | None = None,
     scene: str | None = None,
     plan_only: bool = False,
+    robot: str | None = None,
 ) -> dict[str, Any]:
     """Run episode ``index`` of the suite in ``suite_file`` (its seed, or ``seed``; its scene, or ``scene``: a
-    name, or a file's absolute path); figures and verdict as a dict.
+    name, or a file's absolute path; its robot, or ``robot``); figures and verdict as a dict.
 
     ``events``, when given, receives the run's event log (tests look at how a fault was recovered from).
     """
     started = time.perf_counter()
-    suite = _suite(suite_file, scene)
+    suite = _suite(suite_file, scene, robot)
     if seed is not None:
         suite = suite.model_copy(update={"seed": seed})
     if suite.instructions:

@@ -20,6 +20,7 @@ from bt_humanoid.errors import UserError, did_you_mean
 from bt_humanoid.evaluation.faults import FAULT_MODELS, FaultConfig
 from bt_humanoid.evaluation.goals import Catalogue, Goal
 from bt_humanoid.mission.loader import MissionLoader
+from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.scene_config import Placement, SceneConfig, load_scene
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.strict_model import StrictModel, exactly_one
@@ -137,11 +138,17 @@ class Suite(StrictModel):
         return self
 
 
-def load_suite(file: Path, scene: str | None = None) -> tuple[Suite, WorldConfig]:
+def load_suite(file: Path, scene: str | None = None, robot: str | None = None) -> tuple[Suite, WorldConfig]:
     """A validated suite and its world; a UserError at file:line for anything wrong. ``scene`` (by name, or a
-    file relative to the working directory) replaces the suite's; the suite returned names its scene so that
-    it loads from anywhere (a file's path made absolute)."""
+    file relative to the working directory) replaces the suite's, and ``robot`` (a folder of robots/) its robot;
+    the suite returned names its scene so that it loads from anywhere (a file's path made absolute)."""
     suite, source = read_model(file, Suite, "a suite is a mapping (suite:, tasks:, ...)")
+    if robot is not None:
+        try:
+            load_robot_config(robot)
+        except UserError as error:
+            raise UserError(f"--robot {robot}: {error.message}", hint=error.hint) from None
+        suite = suite.model_copy(update={"robot": robot})
     world = _world(suite, source)
     if scene is not None:
         suite = suite.model_copy(update={"scene": _absolute(scene, Path.cwd())})

@@ -70,6 +70,7 @@ class RouteFollower:
         self.max_speed = inp.max_velocity[0]
         self.route = route
         self.started_settling: float | None = None
+        self.settle_time = SETTLE_TIMEOUT  # s from then the base has to come within tolerance
         self.stop_at = None
         self.speed_limit = math.inf
         self.base.reset_hold()
@@ -143,6 +144,8 @@ class RouteFollower:
         cap = math.sqrt(LATERAL_ACCEL / kappa) if kappa > 1e-6 else self.max_speed
         if limits.turn_first is not None:
             cap = min(cap, self._final_turn_cap(route, s, yaw))
+        if limits.max_sideways_speed is not None:  # at the heading the base has, not the one it is turning to
+            cap = min(cap, self._sideways_cap(route, s, float(self.base.pose()[2])))
         if self.stop_at is not None:  # something ahead: slow so the base can stop short of it
             room = max(self.stop_at - STOP_SHORT - s, 0.0)
             cap = min(cap, math.sqrt(2 * limits.max_accel * room))
@@ -156,6 +159,19 @@ class RouteFollower:
         heading = yaw if to_go < FINAL_STRETCH else route.heading(len(route.points) - 1)
         turn = abs(wrap_angle(route.goal_yaw - heading))
         return to_go * self.config.limits.max_yaw_rate / turn if turn > 1e-6 else math.inf
+
+    def _sideways_cap(self, route: Route, s: float, yaw: float) -> float:
+        """The speed a base slower sideways than forwards makes along the route facing ``yaw``: on the ellipse of
+        its forward and sideways speeds. Turning to the goal's yaw on the last stretch, a walking base was asked
+        to go sideways at the route's speed, fell 0.3 m behind, and ran out of time side-stepping to the goal."""
+        limits = self.config.limits
+        assert limits.max_sideways_speed is not None
+        along = self._point(route, s)[1]
+        if not np.any(along):
+            return math.inf
+        angle = math.atan2(along[1], along[0]) - yaw
+        forward, sideways = math.cos(angle) / self.max_speed, math.sin(angle) / limits.max_sideways_speed
+        return 1.0 / math.hypot(forward, sideways)
 
     def _heading_target(self, route: Route, s: float, index: int) -> float:
         if route.length - s < FINAL_STRETCH or route.length < 1e-6:
@@ -197,9 +213,14 @@ class RouteFollower:
             self.base.track(np.array([*goal, route.goal_yaw]), np.zeros(3))  # hold the goal
             return
         now = self.base.time
-        self.started_settling = self.started_settling if self.started_settling is not None else now
-        # a slow base (a biped turning at 0.3 rad/s, a step at a time) gets the time its last turn takes as well
-        settle = SETTLE_TIMEOUT + abs(wrap_angle(route.goal_yaw - pose[2])) / self.config.limits.max_yaw_rate
+        if self.started_settling is None:
+            self.started_settling = now
+            # a slow base (a biped turning at 0.3 rad/s, side-stepping at 0.08 m/s, a step at a time) gets the
+            # time its last turn and its last steps take as well, at its slowest
+            limits = self.config.limits
+            slowest = min(limits.max_speed, limits.max_sideways_speed or limits.max_speed)
+            self.settle_time = SETTLE_TIMEOUT + yaw_error / limits.max_yaw_rate + remaining / slowest
+        settle = self.settle_time
         if arrived:  # within tolerance and coming to rest: as long again for its last steps
             settle *= 2
         if now - self.started_settling > settle:

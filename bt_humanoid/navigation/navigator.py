@@ -44,6 +44,9 @@ LOOKAHEAD = 2.5  # m of route ahead checked against the map at every update
 MAX_REPLANS = 30  # per goal, before the goal fails as blocked
 WAIT_LIMIT = 15.0  # s to wait, stopped, for a blocked way to clear before the goal fails
 FREE_SAMPLES = 12  # points along the low end of each ray that mark free cells
+# m a robot standing nearer furniture than its footprint allows a route to start (a biped works 0.25 m from a
+# table's edge, inside its 0.36 m footprint) steps straight back, at most, before it plans
+STEP_OUT = 0.4
 
 
 class Navigator:
@@ -70,7 +73,8 @@ class Navigator:
         self.planning_times: list[float] = []  # s of wall time per plan, for benchmarks
         self.route_lengths: list[float] = []  # m, per route planned
         self.route: Route | None = None
-        self.motion: MotionHandle | None = None  # the follower's handle for the current route
+        self.motion: MotionHandle | None = None  # the follower's handle for the current route (or the step out)
+        self.stepping_out = False  # backing straight out of a working stance before the first plan
         self.waiting_since: float | None = None  # stopped because no route is free now
         self.resume_tilt: float | None = None  # the head's tilt before a wait (it looks down at the goal meanwhile)
 
@@ -91,6 +95,7 @@ class Navigator:
             self.follower = RouteFollower(self.robot.base, self.robot.config.base, self.robot.control_period)
         self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), self.robot.base.capped(max_speed), 0
         self.waiting_since = None
+        self.stepping_out = False
         handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
         self.handle = handle
         self._update_map()
@@ -99,6 +104,9 @@ class Navigator:
 
     def halt(self) -> None:
         """Stop following; the base brakes to rest."""
+        if self.stepping_out:
+            self.stepping_out = False
+            self.robot.base.brake()
         self.follower.stop()
         self.goal = None
         self.waiting_since = None
@@ -124,7 +132,7 @@ class Navigator:
         if self.handle is None:
             return  # the map is updated while navigating (scans cost time, and nothing reads it otherwise)
         now = self.robot.base.time
-        if self.camera is not None and now - self.last_scan >= self.scan_period - 1e-9:
+        if self.camera is not None and now - self.last_scan >= self.scan_period - 1e-9 and not self.stepping_out:
             self.last_scan = now
             self._update_map()
             blocked_at = self._blocked_at()
@@ -142,7 +150,8 @@ class Navigator:
         if self.waiting_since is not None:
             self.handle.feedback = f"waiting for the way to clear ({now - self.waiting_since:.0f} s)"
             return
-        self.follower.step()
+        if not self.stepping_out:
+            self.follower.step()
         motion = self.motion
         if motion is None or motion.done:
             self._settle(motion)
@@ -162,7 +171,10 @@ class Navigator:
         return route
 
     def _plan_and_follow(self) -> None:
-        """The first plan of a goal: no route fails the goal at once (the map says the goal cannot be reached)."""
+        """The first plan of a goal: no route fails the goal at once (the map says the goal cannot be reached).
+        A robot nearer furniture than a route may start first steps straight back (``_step_out``)."""
+        if self._step_out():
+            return
         try:
             route = self._plan()
         except PlanError as error:
@@ -260,7 +272,29 @@ class Navigator:
         blocked = ahead[self.grid.clearance_at(route.points[ahead]) < self.clearance.minimum]
         return float(route.arc_length[blocked[0]]) if len(blocked) else None
 
+    def _step_out(self) -> bool:
+        """Back straight out, facing the same way, to where a route may start: the nearest point behind within
+        ``STEP_OUT`` with the footprint's clearance. False (plan as it stands) where none is needed or found."""
+        pose = self.robot.base.pose()
+        if self.grid.clearance_at(pose[None, :2])[0] >= self.clearance.minimum:
+            return False
+        back = -np.array([math.cos(pose[2]), math.sin(pose[2])])
+        steps = np.arange(self.grid.resolution, STEP_OUT + 1e-9, self.grid.resolution)
+        points = pose[:2] + steps[:, None] * back
+        free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
+        if not free.size:
+            return False
+        x, y = points[free[0]]
+        self.stepping_out = True
+        self.motion = self.robot.base.move_to(float(x), float(y), float(pose[2]), max_speed=self.max_speed)
+        return True
+
     def _settle(self, motion: MotionHandle | None) -> None:
+        if self.stepping_out:
+            self.stepping_out = False
+            if motion is not None and motion.status.name == "SUCCEEDED":
+                self._plan_and_follow()
+                return
         if motion is not None and motion.status.name == "SUCCEEDED":
             self.handle.succeed(motion.result)
             self.handle = None

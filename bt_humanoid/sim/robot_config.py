@@ -28,6 +28,8 @@ class BaseLimits(StrictModel):
     #: rad of heading error beyond which the base turns towards its route before it moves along it; None: it
     #: turns while it moves (a wheeled base; a biped walks three times faster forwards than sideways)
     turn_first: float | None = None
+    #: m/s the base moves sideways to its heading; None: as fast as forwards (a wheeled base)
+    max_sideways_speed: float | None = Field(None, gt=0)
 
 
 class BaseTolerance(StrictModel):

@@ -53,6 +53,7 @@ LEG_POSTURE_GAINS = (10.0, 6.0)
 # trajectories plan under); a servo is not a motor, and the QP does not drive it faster than its plans do
 SERVO_SPEED_MARGIN = 1.5
 HELD_JOINTS_GAIN = 10.0
+LIMIT_MARGIN = 0.01  # rad (m) the QP keeps inside each joint's range
 # rad the QP keeps each knee bent at the least. A straight leg is singular: its foot cannot be lifted (a stance leg
 # pushed sideways straightened to its stop, and the recovery step that followed dragged its sole along the floor)
 LEAST_KNEE_BEND = 0.15
@@ -119,6 +120,10 @@ class BalanceController:
         ranges = np.array([model.jnt_range[model.joint(j).id] for j in controlled])
         knees = [controlled.index(leg.joints[LEG_ROLES.index("knee")]) for leg in (legs.left, legs.right)]
         ranges[knees, 0] = np.maximum(ranges[knees, 0], LEAST_KNEE_BEND)
+        # the lift rests on its lower stop (walking, 'home'): its bound is the stop itself, not a margin above it
+        # (which lifted it 1 cm at the start with a jolt that tipped a foot onto its edge)
+        lifts = [controlled.index(j) for j in config.groups.get("lift", []) if j in controlled]
+        ranges[lifts, 0] -= LIMIT_MARGIN
         speeds = np.array(
             [
                 legs.speed_limit(j) if j in legs.joints else SERVO_SPEED_MARGIN * config.motion_limits(j).velocity
@@ -129,7 +134,7 @@ class BalanceController:
             {j: legs.torque_limit(j) for j in self.legs} | {j: s[2] for j, s in zip(self.servoed, servos, strict=True)}
         )
         self.bounds = [
-            JointLimit(controlled, ranges[:, 0], ranges[:, 1], speeds),
+            JointLimit(controlled, ranges[:, 0], ranges[:, 1], speeds, margin=LIMIT_MARGIN),
             HeldJointLimit(self.held, HELD_JOINTS_GAIN),
         ]
 

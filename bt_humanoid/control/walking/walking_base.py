@@ -30,12 +30,9 @@ from bt_humanoid.sim.standing import standing_posture
 
 POSITION_GAIN = 1.0  # 1/s: body velocity per metre (radian) of error from a streamed reference
 LARGEST_TURN = math.pi / 2  # rad of a long turn fed to the walker at once (its goals wrap at half a circle)
-GOAL_TIMEOUT = 10.0
+GOAL_TIMEOUT = 10.0  # s beyond the time a pose goal should take at the allowed speeds before it fails
 SETTLED_SPEED = 0.02  # m/s of the pelvis below which a robot standing after its last step has settled
 OFFSET_FILTER = 0.01  # per control step: the pelvis's offset from the centre of mass, averaged over about a second
-# m/s a streamed reference may ask sideways: about what a pair of sidesteps covers (0.12 m in 1.4 s); more turns
-# into steps at the edges of what the legs reach while they walk forwards and turn as well
-SIDEWAYS_SPEED = 0.08  # s beyond the time a pose goal should take at the allowed speeds before it fails
 
 
 def wrap(angle: float) -> float:
@@ -200,6 +197,7 @@ class WalkingBase(SpeedMonitoring):
         speed = float(np.hypot(body[0], body[1]))
         if speed > self.capped():
             body[:2] *= self.capped() / speed
-        body[1] = float(np.clip(body[1], -SIDEWAYS_SPEED, SIDEWAYS_SPEED))
+        sideways = limits.max_sideways_speed if limits.max_sideways_speed is not None else limits.max_speed
+        body[1] = float(np.clip(body[1], -sideways, sideways))
         body[2] = float(np.clip(body[2], -limits.max_yaw_rate, limits.max_yaw_rate))
         self.walker.command(*body)

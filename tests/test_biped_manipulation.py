@@ -1,0 +1,53 @@
+"""The walking biped does the job on its legs (issue 25, docs/walking.md "Working on legs"): it picks an object
+up, and leaves a table it worked at, balancing all the while. Judged in ground truth."""
+
+from __future__ import annotations
+
+import pytest
+
+from bt_humanoid.testing.scenario import build_run
+
+pytestmark = pytest.mark.sim
+
+OBJECTS = {"red_cube", "blue_cube", "water_bottle", "coffee_mug", "yellow_ball"}  # the apartment's, by geom
+
+
+def run_watching_contacts(mission: dict, start: tuple[float, float, float] | None = None):
+    """Run ``mission`` on the biped from ``start`` (the world's start if None): the result, the run, and every
+    contact of the robot with something other than the floor under its soles or what its fingers may touch."""
+    run = build_run({"world": "apartment", "robot": "biped_humanoid", **mission}, robot_start=start)
+    touched: set[tuple[str, str]] = set()
+
+    def watch() -> None:
+        for mine, other in run.truth.robot_contacts():
+            on_feet = "_sole_" in mine and other == "floor"
+            # the finger pads may touch what they grasp, and brush the top it stands on: the arm's servos follow
+            # the balance QP's torques and the hand comes down 6 mm below its target (the wheeled robot's do not)
+            fingers = "_pad_" in mine and (other.endswith("_top") or any(other.startswith(n) for n in OBJECTS))
+            if not (on_feet or fingers):
+                touched.add((mine, other))
+
+    run.executor.observers.append(watch)
+    result = run.execute()
+    run.stack.close()
+    return result, run, touched
+
+
+def test_the_biped_picks_the_red_cube_from_the_table():
+    result, run, touched = run_watching_contacts({"mission": "pick on legs", "tree": {"pick": {"object": "red cube"}}})
+    assert result.success, result.cause
+    assert run.truth.in_hand("red cube") == "right"
+    assert run.truth.object_position("red cube")[2] > 0.85  # lifted clear of the table (its top: 0.75 m)
+    assert run.robot.walking.walker.fallen is None
+    assert not touched
+
+
+def test_from_a_working_stance_inside_its_footprint_it_steps_back_then_walks_away():
+    """The biped works 0.25 m from a table's edge, nearer than its 0.36 m footprint lets a route start: it steps
+    straight back before it plans (at first the planner refused: "too close to an obstacle to plan from")."""
+    result, run, touched = run_watching_contacts(
+        {"mission": "leave the table", "tree": {"navigate": {"place": "kitchen"}}}, (2.55, 0.39, 0.0)
+    )
+    assert result.success, result.cause
+    assert run.robot.walking.walker.fallen is None
+    assert not touched
