@@ -33,42 +33,44 @@ def stance_for(
     standoff: float | None = None,
     max_depth: float = MAX_DEPTH,
     hand_lateral: float = HAND_LATERAL,
+    closest: float | None = None,
 ) -> tuple[float, float, float]:
     """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``: ``standoff`` m from
     the edge (default: the footprint ``EDGE_CLEARANCE`` clear of it), the spot at most ``max_depth`` behind it
-    and ``hand_lateral`` to the working hand's side.
+    and ``hand_lateral`` to the working hand's side. With ``closest``, a deeper spot brings the stance nearer
+    the edge by as much, down to ``closest`` m from it: the hand then reaches as far ahead of the base.
 
     Of the edges that reach the spot, the one whose stance is nearest the robot wins.
     """
     (x0, y0), (x1, y1) = surface.region
     x, y = float(spot[0]), float(spot[1])
     standoff = footprint_radius + EDGE_CLEARANCE if standoff is None else standoff
-    # (depth of the spot behind the edge, stance position on the line through the spot, facing yaw)
-    edges = [
-        (x - x0, np.array([x0 - standoff, y]), 0.0),
-        (x1 - x, np.array([x1 + standoff, y]), math.pi),
-        (y - y0, np.array([x, y0 - standoff]), math.pi / 2),
-        (y1 - y, np.array([x, y1 + standoff]), -math.pi / 2),
-    ]
+    nearest = standoff if closest is None else min(closest, standoff)
+    reach = max_depth + standoff - nearest
+    # (depth of the spot behind the edge, the edge's point on the line through the spot, facing yaw)
+    edges = [(x - x0, (x0, y), 0.0), (x1 - x, (x1, y), math.pi), (y - y0, (x, y0), math.pi / 2)]
+    edges.append((y1 - y, (x, y1), -math.pi / 2))
     lateral = hand_lateral if side == "right" else -hand_lateral
     options = []
-    for depth, position, yaw in edges:
+    for depth, edge, yaw in edges:
+        facing = np.array([math.cos(yaw), math.sin(yaw)])
+        distance = float(np.clip(standoff - (depth - max_depth), nearest, standoff))
         left = np.array([-math.sin(yaw), math.cos(yaw)])
-        stance = position + lateral * left  # the spot ends up on the working hand's side
+        stance = np.array(edge) - distance * facing + lateral * left  # the spot on the working hand's side
         inside = np.all(stance >= bounds[0] + footprint_radius) and np.all(stance <= bounds[1] - footprint_radius)
         if inside:
             options.append((depth, stance, yaw))
     if not options:
         raise StanceError(f"no room to stand beside the {surface.name}")
-    reachable = [option for option in options if option[0] <= max_depth]
+    reachable = [option for option in options if option[0] <= reach]
     if reachable:
         depth, stance, yaw = min(reachable, key=lambda option: float(np.linalg.norm(option[1] - robot_xy)))
     else:
         depth, stance, yaw = min(options, key=lambda option: option[0])
-    if depth > max_depth:
+    if depth > reach:
         raise StanceError(
             f"spot ({x:.2f}, {y:.2f}) is {depth:.2f} m behind the nearest free edge of the {surface.name}; "
-            f"the arm reaches {max_depth:.2f} m"
+            f"the arm reaches {reach:.2f} m"
         )
     return float(stance[0]), float(stance[1]), yaw
 
@@ -88,4 +90,5 @@ def working_stance(
         standoff=stance.standoff,
         max_depth=stance.reach_depth,
         hand_lateral=stance.hand_lateral,
+        closest=stance.closest,
     )

@@ -54,6 +54,12 @@ class WorkingStance(StrictModel):
     )
     reach_depth: float = Field(0.42, gt=0, description="m behind the edge the hand reaches from the stance")
     hand_lateral: float = Field(0.18, ge=0, description="m to its side of the base's centre line the spot lies")
+    closest: float | None = Field(
+        None,
+        gt=0,
+        description="m from the edge the base may come for a spot deeper than reach_depth (nearer by as much as "
+        "the spot is deeper); None: it stands at standoff",
+    )
 
 
 class BaseConfig(StrictModel):

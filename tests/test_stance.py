@@ -1,0 +1,53 @@
+"""Where the robot stands to work at a surface (control/stance.py): facing the nearest edge, the spot in front of
+the working hand, as near as each robot's ``base.working_stance`` says."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bt_humanoid.control.stance import StanceError, stance_for, working_stance
+from bt_humanoid.perception.world_model import SupportSurface
+from bt_humanoid.sim.robot_config import load_robot_config
+
+TABLE = SupportSurface("table", np.array([[1.8, -0.45], [3.0, 0.45]]), 0.75)  # the apartment's
+BOUNDS = np.array([[-2.0, -4.5], [9.0, 4.5]])
+SOUTH = np.array([2.4, -3.0])  # the robot comes from the south: the south edge (y = -0.45) is nearest
+
+
+def test_the_wheeled_robot_stands_its_footprint_clear_of_the_edge_with_the_spot_in_front_of_its_hand():
+    base = load_robot_config("wheeled_humanoid").base
+    x, y, yaw = working_stance(np.array([2.4, -0.2]), TABLE, "right", base, BOUNDS, SOUTH)
+    assert yaw == pytest.approx(math.pi / 2)  # facing the table (north)
+    assert y == pytest.approx(-0.45 - base.footprint_radius - 0.05)
+    assert x == pytest.approx(2.4 - 0.18)  # the spot 0.18 m to the right of the base's centre line
+
+
+def test_the_biped_comes_nearer_for_a_deeper_spot_down_to_its_closest():
+    base = load_robot_config("biped_humanoid").base
+    stance = base.working_stance
+    edge = -0.45
+
+    def distance_from_edge(depth: float) -> float:
+        return edge - working_stance(np.array([2.4, edge + depth]), TABLE, "right", base, BOUNDS, SOUTH)[1]
+
+    assert distance_from_edge(0.1) == pytest.approx(stance.standoff)
+    assert distance_from_edge(stance.reach_depth) == pytest.approx(stance.standoff)
+    assert distance_from_edge(stance.reach_depth + 0.04) == pytest.approx(stance.standoff - 0.04)
+    deepest = stance.reach_depth + stance.standoff - stance.closest
+    assert distance_from_edge(deepest) == pytest.approx(stance.closest)
+    # beyond, from no edge: the message names how far the arm reaches
+    with pytest.raises(StanceError, match=f"the arm reaches {deepest:.2f} m"):
+        stance_for(
+            np.array([2.4, 0.0]),
+            SupportSurface("wide", np.array([[1.0, -1.0], [4.0, 1.0]]), 0.75),
+            "right",
+            base.footprint_radius,
+            BOUNDS,
+            SOUTH,
+            standoff=stance.standoff,
+            max_depth=stance.reach_depth,
+            closest=stance.closest,
+        )
