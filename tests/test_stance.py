@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from bt_humanoid.control.stance import StanceError, stance_for, working_stance
+from bt_humanoid.control.stance import StanceError, working_stance
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.sim.robot_config import load_robot_config
 
@@ -39,15 +39,6 @@ def test_the_biped_comes_nearer_for_a_deeper_spot_down_to_its_closest():
     deepest = stance.reach_depth + stance.standoff - stance.closest
     assert distance_from_edge(deepest) == pytest.approx(stance.closest)
     # beyond, from no edge: the message names how far the arm reaches
+    wide = SupportSurface("wide", np.array([[1.0, -1.0], [4.0, 1.0]]), 0.75)
     with pytest.raises(StanceError, match=f"the arm reaches {deepest:.2f} m"):
-        stance_for(
-            np.array([2.4, 0.0]),
-            SupportSurface("wide", np.array([[1.0, -1.0], [4.0, 1.0]]), 0.75),
-            "right",
-            base.footprint_radius,
-            BOUNDS,
-            SOUTH,
-            standoff=stance.standoff,
-            max_depth=stance.reach_depth,
-            closest=stance.closest,
-        )
+        working_stance(np.array([2.4, 0.0]), wide, "right", base, BOUNDS, SOUTH)

@@ -63,11 +63,10 @@ class RobotController:
         ranges = {j: (io.lower[i], io.upper[i]) for i, j in enumerate(io.joints) if io.limited[i]}
         #: whole-body motions (reaching, gaze): over a planar base, or a walking robot's upper body
         self.feedforward: BaseAccelerationFeedforward | None = None
-        if self.walking is not None:
-            dynamics = self.walking.walker.dynamics
-            self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges, lambda: dynamics.q)
-        else:
-            self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges)
+        walker = self.walking.walker if self.walking is not None else None
+        estimated = (lambda: walker.dynamics.q) if walker is not None else None
+        self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges, estimated)
+        if walker is None:
             self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, self.config.base.planar_joints)
         self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
         self.separation: Separation | None = None  # set with monitor_separation()

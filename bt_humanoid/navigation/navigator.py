@@ -114,6 +114,15 @@ class Navigator:
             self.handle.fail("halted: braking")
             self.handle = None
 
+    def room_behind(self, xy: np.ndarray, yaw: float, longest: float) -> np.ndarray | None:
+        """The nearest point straight behind ``xy`` (facing ``yaw``), at most ``longest`` back, where a route may
+        start or end (the footprint's clearance on the map); ``xy`` itself if it has room; None if none has."""
+        back = -np.array([math.cos(yaw), math.sin(yaw)])
+        steps = np.arange(0.0, longest + 1e-9, self.grid.resolution)
+        points = np.asarray(xy, dtype=float)[:2] + steps[:, None] * back
+        free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
+        return points[free[0]] if free.size else None
+
     def is_furniture(self, points: np.ndarray) -> np.ndarray:
         """Per floor point (x, y): on or next to the map's furniture and walls (outside the map counts too)."""
         rows, cols = self.grid.cell(points)
@@ -276,15 +285,10 @@ class Navigator:
         """Back straight out, facing the same way, to where a route may start: the nearest point behind within
         ``STEP_OUT`` with the footprint's clearance. False (plan as it stands) where none is needed or found."""
         pose = self.robot.base.pose()
-        if self.grid.clearance_at(pose[None, :2])[0] >= self.clearance.minimum:
+        out = self.room_behind(pose[:2], float(pose[2]), STEP_OUT)
+        if out is None or np.allclose(out, pose[:2]):
             return False
-        back = -np.array([math.cos(pose[2]), math.sin(pose[2])])
-        steps = np.arange(self.grid.resolution, STEP_OUT + 1e-9, self.grid.resolution)
-        points = pose[:2] + steps[:, None] * back
-        free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
-        if not free.size:
-            return False
-        x, y = points[free[0]]
+        x, y = out
         self.stepping_out = True
         self.motion = self.robot.base.move_to(float(x), float(y), float(pose[2]), max_speed=self.max_speed)
         return True

@@ -300,12 +300,10 @@ class StandNear(_ManipulationSkill):
         navigator = self.context.navigator
         if navigator is None or not self._straight_way_blocked(np.array([x, y])):
             return None
-        back = np.array([math.cos(yaw), math.sin(yaw)])
-        steps = np.arange(0.0, APPROACH_BACKOFF + 1e-9, navigator.grid.resolution)
-        options = np.array([x, y]) - steps[:, None] * back
-        fits = np.flatnonzero(navigator.grid.clearance_at(options) >= navigator.clearance.minimum)
-        x, y = options[fits[0]] if fits.size else options[-1]
-        return navigator.go_to(np.array([x, y, yaw]), p.max_speed)
+        end = navigator.room_behind(np.array([x, y]), yaw, APPROACH_BACKOFF)
+        if end is None:  # no room behind either: the navigator says why
+            end = np.array([x, y])
+        return navigator.go_to(np.array([*end, yaw]), p.max_speed)
 
     def _drive(self) -> MotionHandle | None:
         p: StandNearParams = self.params

@@ -96,8 +96,9 @@ class BalanceController:
         self._lift_q = np.array([self.dynamics.joint_index(j) + 1 for j in lifts], dtype=int)
         self._lift_share = np.array([data.mass[model.getJointId(j)] / data.mass[0] for j in lifts])
 
-        # who drives what: leg motors take torques; the upper body's servos take targets; the torso lift and the
-        # fingers stay with their own servos (the lift at its stop, the grippers to the gripper controller)
+        # who drives what: leg motors take torques; the upper body's servos (the lift among them, where it is in a
+        # group) take targets; the fingers and any joint in no group stay with their own servos (the grippers to
+        # the gripper controller)
         grouped = {joint for group in config.groups.values() for joint in group}
         self.held = [j for j in joints if j in config.finger_joints or (j not in legs.joints and j not in grouped)]
         self.servoed = [j for j in joints if j not in legs.joints and j not in self.held]
