@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bt_humanoid.control.walking.footsteps import LEFT, RIGHT, Footstep, StepLimits
-from bt_humanoid.control.walking.stepping import Sole, capture_step, cop_room
+from bt_humanoid.control.walking.stepping import Sole, capture_step, cop_room, crosses
 
 OMEGA = math.sqrt(9.81 / 0.72)
 SOLE = Sole(0.10, 0.04)
@@ -68,8 +68,18 @@ def test_a_push_beyond_reach_lands_the_foot_as_soon_as_it_may_at_the_edge_of_rea
     assert footstep.relative_to(STANCE)[0] == pytest.approx(LIMITS.forward[1])
 
 
-def test_a_push_towards_the_stance_side_lands_the_swinging_foot_beside_it_soon():
-    adjusted, _ = adjust(plan_dcm(0.0) + np.array([0.0, -0.15]))  # to the right, over the right (stance) foot
+@pytest.mark.parametrize("push", [0.06, 0.15])
+def test_a_push_towards_the_stance_side_lands_the_swinging_foot_beside_it_as_soon_as_it_may(push):
+    # to the right, over the right (stance) foot: only the right foot can catch it, once the left is down
+    adjusted, _ = adjust(plan_dcm(0.0) + np.array([0.0, -push]))
     footstep, duration = adjusted
     assert footstep.relative_to(STANCE)[1] == pytest.approx(LIMITS.sideways[0])  # the feet do not cross
-    assert duration < REMAINING
+    assert duration == pytest.approx(SHORTEST)
+
+
+def test_a_footstep_crosses_when_it_lies_nearer_the_other_side_than_the_feet_may_come():
+    beside = STANCE.moved(0.1, LIMITS.sideways[0], 0.0, LEFT)
+    assert not crosses(beside, STANCE, LIMITS)
+    assert crosses(STANCE.moved(0.1, 0.05, 0.0, LEFT), STANCE, LIMITS)  # the soles would overlap
+    assert crosses(STANCE.moved(0.0, -0.1, 0.0, LEFT), STANCE, LIMITS)  # the left foot right of the right
+    assert not crosses(STANCE.moved(0.0, -0.2, 0.0, RIGHT), Footstep(LEFT, 0.0, 0.0, 0.0), LIMITS)
