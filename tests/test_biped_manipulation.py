@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 
+from bt_humanoid.control.wbc.dynamics import RobotDynamics
 from bt_humanoid.testing.scenario import build_run
 
 pytestmark = pytest.mark.sim
@@ -40,6 +41,13 @@ def test_the_biped_picks_the_red_cube_from_the_table():
     assert run.truth.object_position("red cube")[2] > 0.85  # lifted clear of the table (its top: 0.75 m)
     assert run.robot.walking.walker.fallen is None
     assert not touched
+    # the wrist weighed it (0.1 kg), and the balance counts it at the grip point
+    mass = float(run.sim.model.body("red_cube").mass[0])
+    believed = run.stack.context.world_model.held("right")
+    assert believed is not None and believed.weight == pytest.approx(mass, abs=0.02)
+    dynamics = run.robot.walking.walker.dynamics
+    assert dynamics.payloads["r_grip"] == believed.weight
+    assert dynamics.mass == pytest.approx(RobotDynamics(run.robot.config).mass + believed.weight)
 
 
 def test_from_a_working_stance_inside_its_footprint_it_steps_back_then_walks_away():

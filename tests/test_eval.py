@@ -110,6 +110,20 @@ def test_an_unknown_fault_kind_names_the_valid_ones(tmp_path):
     assert "suite.yaml:9" in str(error.value) and "earthquake" in str(error.value)
 
 
+def test_a_time_budget_per_robot_gives_each_robot_its_own(tmp_path):
+    task = "tasks:\n  - command: bring me the {object}\n    expect: [{delivered: '{object}'}]\n"
+    file = _suite(
+        tmp_path, f"suite: s\nobjects: [red cube]\n{task}time_budget: {{wheeled_humanoid: 300, biped_humanoid: 900}}\n"
+    )
+    assert load_suite(file)[0].episode_budget == 300
+    assert load_suite(file, robot="biped_humanoid")[0].episode_budget == 900
+    only_wheels = _suite(tmp_path, f"suite: s\nobjects: [red cube]\n{task}time_budget: {{wheeled_humanoid: 300}}\n")
+    with pytest.raises(UserError) as error:
+        load_suite(only_wheels, robot="biped_humanoid")
+    assert "suite.yaml:6" in str(error.value) and "biped_humanoid" in str(error.value)
+    assert load_suite(BENCHMARKS / "smoke.yaml", robot="biped_humanoid")[0].episode_budget == 240  # one for all
+
+
 def test_bt_eval_exits_2_with_one_line_for_bad_input(tmp_path, capsys):
     assert eval_main([str(tmp_path / "missing.yaml")]) == 2
     err = capsys.readouterr().err.strip()

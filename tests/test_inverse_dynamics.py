@@ -318,3 +318,24 @@ def test_a_30_newton_second_push_is_taken_by_the_ankles_and_hips(config, directi
         assert np.linalg.norm(sim.data.site(site).xpos[:2] - before[:2]) < 0.01
     middle = (feet[0] + feet[1]) / 2
     assert np.linalg.norm(controller.dcm() - middle[:2]) < 0.02  # balanced again over the middle of the feet
+
+
+def test_a_payload_at_the_grip_point_adds_its_mass_where_the_hand_holds_it(dynamics, stance):
+    q = np.concatenate(
+        [[0.0, 0.0, stance.pelvis_height, 0.0, 0.0, 0.0, 1.0], [stance.joints[j] for j in dynamics.joints]]
+    )
+    v = np.zeros(dynamics.nv)
+    dynamics.update(q, v)
+    bare_mass, bare_com, bare_gravity = dynamics.mass, dynamics.com.copy(), dynamics.bias.copy()
+    grip = dynamics.pose("r_grip").translation.copy()
+    dynamics.set_payload("r_grip", 0.5)
+    dynamics.update(q, v)
+    assert dynamics.mass == pytest.approx(bare_mass + 0.5)
+    assert RobotDynamics(load_robot_config(ROBOT)).mass == pytest.approx(bare_mass)  # its own model, not shared
+    assert dynamics.com == pytest.approx((bare_mass * bare_com + 0.5 * grip) / (bare_mass + 0.5))
+    # held still, the joints carry its weight at the grip point: h grows by J_gripᵀ (0, 0, m g)
+    weight = dynamics.jacobian("r_grip")[:3].T @ np.array([0.0, 0.0, 0.5 * dynamics.gravity])
+    assert dynamics.bias - bare_gravity == pytest.approx(weight, abs=1e-9)
+    dynamics.set_payload("r_grip", 0.0)  # let go
+    dynamics.update(q, v)
+    assert dynamics.mass == pytest.approx(bare_mass) and dynamics.com == pytest.approx(bare_com)

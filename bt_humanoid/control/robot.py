@@ -17,6 +17,7 @@ from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.inertial_feedforward import BaseAccelerationFeedforward
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.motion import REST_SPEED
+from bt_humanoid.control.payload import WristScale
 from bt_humanoid.control.walking.walking_base import WalkingBase
 from bt_humanoid.control.whole_body import WholeBodyController
 from bt_humanoid.sim.robot_config import RobotConfig
@@ -68,6 +69,8 @@ class RobotController:
         self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges, estimated)
         if walker is None:
             self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, self.config.base.planar_joints)
+        #: a legged robot's wrist sensors weigh what it lifts, and its balance counts that mass (``weigh``)
+        self.scale = WristScale(self.config, walker.io, walker.dynamics) if walker is not None else None
         self.planners: list[Planner] = []  # run before the controllers each step (the navigator)
         self.separation: Separation | None = None  # set with monitor_separation()
         self.control_period = 0.01  # s between step() calls; the executor sets it
@@ -100,6 +103,20 @@ class RobotController:
                 joints.position[upper], joints.velocity[upper], joints.acceleration[upper]
             )
         self.grippers.step()
+        if self.scale is not None:
+            self.scale.update(self.control_period)
+            for side in self.scale.sensors:  # a hand that let go (or lost its hold) carries nothing
+                if self.scale.carried(side) > 0.0 and not self.grippers.holding(side):
+                    self.scale.carry(side, 0.0)
+
+    def weigh(self, side: str) -> float | None:
+        """Weigh what the ``side`` hand holds (kg) and, on legs, balance with it from now until it lets go; None
+        for a robot without a wrist sensor on that hand, or with no balance to tell (a wheeled base)."""
+        if self.scale is None or side not in self.scale.sensors:
+            return None
+        mass = self.scale.weigh(side)
+        self.scale.carry(side, mass)
+        return mass
 
     def brake(self) -> None:
         """Halt every motion: base and joints decelerate to rest under their limits."""

@@ -247,7 +247,7 @@ def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, stack: Robot
     if task.mission is not None:
         # the episode's scene, not the mission's: success conditions name the objects of this run
         spec = MissionLoader(scene=stack.sim.scene).load_file(Path(suite_file).parent / task.mission)
-        spec.header.safety.time_budget = suite.time_budget
+        spec.header.safety.time_budget = suite.episode_budget
         return spec
     return _planned(fill(task.command, draw.slots), suite, stack, figures)
 
@@ -259,7 +259,7 @@ def _planned(command: str, suite: Suite, stack: RobotStack, figures: dict):
     figures["plan_ms"].append(round((time.perf_counter() - started) * 1000, 2))
     if outcome.plan.kind != "mission" or outcome.plan.mission is None:
         return f"planner: {outcome.plan.say}"
-    mission = {**outcome.plan.mission, "safety": {"time_budget": suite.time_budget}}
+    mission = {**outcome.plan.mission, "safety": {"time_budget": suite.episode_budget}}
     return MissionLoader.for_plans().load_data(mission, name="<command>")
 
 

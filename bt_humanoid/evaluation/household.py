@@ -72,7 +72,7 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
             failure = "not run (--plan-only)" if plan_only else f"planner: {plan.say}"
             record |= episode_verdict(stack, None, figures, failure=failure)
         else:
-            mission = {**plan.mission, "safety": {"time_budget": suite.time_budget}}
+            mission = {**plan.mission, "safety": {"time_budget": suite.episode_budget}}
             run = MissionRun(stack, MissionLoader.for_plans().load_data(mission, name="<command>"))
             touched = watch_people(run, stack)
             visited: set[str] = set()

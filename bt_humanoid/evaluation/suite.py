@@ -127,7 +127,25 @@ class Suite(StrictModel):
     )
     randomize: Randomize = Randomize()
     faults: FaultPlan = FaultPlan()
-    time_budget: float = Field(300.0, gt=0, le=86400, description="simulation seconds per episode")
+    time_budget: float | dict[str, float] = Field(
+        300.0,
+        description="simulation seconds per episode: one for every robot, or per robot ({wheeled_humanoid: 300, "
+        "biped_humanoid: 900}: a walking robot takes longer over the same job)",
+    )
+
+    @property
+    def episode_budget(self) -> float:
+        """The simulation seconds each episode may take with the suite's robot."""
+        if isinstance(self.time_budget, dict):
+            return self.time_budget[self.robot]  # present: load_suite checked it
+        return self.time_budget
+
+    @model_validator(mode="after")
+    def _budgets_in_range(self) -> Suite:
+        budgets = self.time_budget.values() if isinstance(self.time_budget, dict) else [self.time_budget]
+        if any(not 0 < budget <= 86400 for budget in budgets):
+            raise ValueError("a time budget is simulation seconds, more than 0 and at most 86400")
+        return self
 
     @model_validator(mode="after")
     def _tasks_or_instructions(self) -> Suite:
@@ -161,6 +179,7 @@ def load_suite(file: Path, scene: str | None = None, robot: str | None = None) -
             load_scene(world, world.scene, named_at=f"worlds/{world.folder.name}/world.yaml") if world.scene else None
         )
     _check_names(suite, world, source)
+    _check_budget(suite, source)
     _check_scene_draw(suite, world, source)
     _check_objects_in_scene(suite, world, start, source)
     _check_tasks(suite, source, _names_scene(suite, world, start))
@@ -184,6 +203,17 @@ def _world(suite: Suite, source: YamlSource) -> WorldConfig:
         return load_world_config(suite.world)
     except UserError as error:
         raise UserError(error.message, where=source.where(("world",)), hint=error.hint) from None
+
+
+def _check_budget(suite: Suite, source: YamlSource) -> None:
+    """A budget per robot names the robot the suite runs (its own, or --robot's)."""
+    if isinstance(suite.time_budget, dict) and suite.robot not in suite.time_budget:
+        given = ", ".join(suite.time_budget)
+        raise UserError(
+            f"time_budget gives no budget for robot '{suite.robot}' (it gives them for {given})",
+            where=source.where(("time_budget",)),
+            hint=f"add '{suite.robot}: SECONDS' to it, or give one number for every robot",
+        )
 
 
 def _check_names(suite: Suite, world: WorldConfig, source: YamlSource) -> None:

@@ -107,6 +107,11 @@ class GripperConfig(StrictModel):
     open: float
     closed: float
     grip_site: str
+    wrist_force: str | None = Field(
+        None,
+        description="the wrist's force sensor (MJCF sensor name), measuring what the hand and its load weigh; "
+        "a legged robot weighs what it lifts with it and balances with that mass",
+    )
     open_range: dict[str, tuple[float, float]] = Field(
         default_factory=dict,
         description="joint ranges (rad) within which the fingers open fully without meeting the arm; "

@@ -513,6 +513,7 @@ class Grasp(_ManipulationSkill):
             self.target.held_by = None
             self.target.confidence = 0.0  # where it went is unknown until it is seen again
             raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
+        self.target.weight = self.context.robot.weigh(self.params.side)  # a legged robot balances with it
 
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt

@@ -29,7 +29,7 @@ class RobotDynamics:
     def __init__(self, config: RobotConfig) -> None:
         if not config.base.floating:
             raise ValueError(f"robot '{config.name}' has no floating base: RobotDynamics is for legged robots")
-        self.model = robot_model(config)
+        self.model = pin.Model(robot_model(config))  # its own copy: a payload changes its inertias
         self.data = self.model.createData()
         if self.model.joints[1].shortname() != "JointModelFreeFlyer":
             raise ValueError(f"robot '{config.name}': the model's first joint must be its free-flyer")
@@ -51,6 +51,26 @@ class RobotDynamics:
         self._jacobians: dict[str, np.ndarray] = {}
         self._drifts: dict[str, np.ndarray] = {}
         self._momentum_drift: np.ndarray | None = None
+        self._bare_inertias = [pin.Inertia(inertia) for inertia in self.model.inertias]
+        self.payloads: dict[str, float] = {}  # kg held at a frame (set_payload)
+
+    # --- what the robot carries ---------------------------------------------------------------------------------
+
+    def set_payload(self, frame: str, mass: float) -> None:
+        """Carry a point mass of ``mass`` kg at ``frame`` (a hand's grip site): it joins the inertia of the body
+        the frame is on, and the whole-body terms, the centre of mass and ``mass`` count it from the next
+        ``update``. 0 takes it away again."""
+        if mass < 0.0:
+            raise ValueError(f"a payload's mass is not negative (got {mass} kg at {frame})")
+        self.payloads[frame] = mass
+        model = self.model
+        for joint, bare in enumerate(self._bare_inertias):
+            model.inertias[joint] = pin.Inertia(bare)
+        for name, held in self.payloads.items():
+            placed = model.frames[self.frame_id(name)]
+            point = pin.Inertia(held, placed.placement.translation, np.zeros((3, 3)))
+            model.inertias[placed.parentJoint] = model.inertias[placed.parentJoint] + point
+        self.mass = float(pin.computeTotalMass(model))
 
     # --- state -----------------------------------------------------------------------------------------------
 
