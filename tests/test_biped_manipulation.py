@@ -1,9 +1,11 @@
 """The walking biped does the job on its legs (issue 25, docs/walking.md "Working on legs"): it picks an object
-up, and leaves a table it worked at, balancing all the while. Judged in ground truth."""
+up and weighs it, leaves a table it worked at, and stands still holding it when stopped mid-walk, balancing all the
+while. Judged in ground truth."""
 
 from __future__ import annotations
 
 import pytest
+from py_trees.common import Status
 
 from bt_humanoid.control.wbc.dynamics import RobotDynamics
 from bt_humanoid.testing.scenario import build_run
@@ -59,3 +61,32 @@ def test_from_a_working_stance_inside_its_footprint_it_steps_back_then_walks_awa
     assert result.success, result.cause
     assert run.robot.walking.walker.fallen is None
     assert not touched
+
+
+def test_a_stop_while_it_walks_off_with_the_cube_stands_it_still_within_two_steps_holding_it():
+    run = build_run(
+        {
+            "world": "apartment",
+            "robot": "biped_humanoid",
+            "mission": "carry",
+            "tree": {"sequence": [{"pick": {"object": "red cube"}}, {"navigate": {"place": "kitchen"}}]},
+        }
+    )
+    executor, walker = run.executor, run.robot.walking.walker
+    executor.events.add(0.0, "start", mission="carry")
+    walking_since = None
+    while walking_since is None or run.sim.time < walking_since + 2.0:  # 2 s into the walk with it
+        assert run.sim.time < 120.0, "never walked off with the cube"
+        executor.tick()
+        executor.advance()
+        carrying = run.truth.in_hand("red cube") == "right" and walker.walking
+        walking_since = (walking_since or run.sim.time) if carrying else None
+    steps = len(walker.touchdowns)
+    run.request_stop("test stop")
+    assert executor.tick() is Status.FAILURE
+    executor.halt()
+    run.stack.close()
+    assert not walker.walking and walker.fallen is None
+    assert len(walker.touchdowns) - steps <= 2
+    assert run.truth.in_hand("red cube") == "right"  # the grip kept
+    assert walker.dynamics.payloads["r_grip"] > 0.05  # and the balance still counts it
