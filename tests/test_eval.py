@@ -6,13 +6,16 @@ import json
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from bt_humanoid.control.stance import deepest_reach
 from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation.command import eval_main
-from bt_humanoid.evaluation.episode import Draw
+from bt_humanoid.evaluation.episode import Draw, _probe
 from bt_humanoid.evaluation.report import summarize, wilson_interval
 from bt_humanoid.evaluation.suite import load_suite
+from bt_humanoid.testing.spots import REACH_SLACK, reachable_spot
 
 BENCHMARKS = Path(__file__).resolve().parents[1] / "missions" / "benchmarks"
 
@@ -216,3 +219,19 @@ def test_the_results_sections_in_docs_are_generated_from_the_committed_runs():
         assert section == markdown(saved, saved["command"]), run.name
         assert len(saved["episodes"]) == saved["success"]["episodes"] >= 200
         assert saved["commit"] and "uncommitted" not in saved["commit"], "a committed run names a clean commit"
+
+
+def test_spots_are_drawn_where_the_robot_s_own_hand_reaches():
+    probe = _probe("apartment", "biped_humanoid")
+    base, world = probe.context.robot_config.base, probe.world
+    table = probe.context.world_model.surface("table")
+    (x0, y0), (x1, y1) = table.region
+    rng = np.random.default_rng(3)
+    args = (table, probe.navigator.grid, base.footprint_radius, np.array(world.bounds), [])
+    deepest = deepest_reach(base)
+    for _ in range(30):
+        x, y = reachable_spot(*args, rng, deepest)
+        assert min(x - x0, x1 - x, y - y0, y1 - y) <= deepest - REACH_SLACK + 1e-9
+    # the wheeled robot's reach is deeper: some of its spots are out of the biped's
+    wheeled = [reachable_spot(*args, rng) for _ in range(30)]
+    assert max(min(x - x0, x1 - x, y - y0, y1 - y) for x, y in wheeled) > deepest - REACH_SLACK

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from bt_humanoid.control.stance import StanceError, working_stance
+from bt_humanoid.control.stance import MAX_DEPTH, StanceError, deepest_reach, working_stance
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.sim.robot_config import load_robot_config
 
@@ -38,6 +38,8 @@ def test_the_biped_comes_nearer_for_a_deeper_spot_down_to_its_closest():
     assert distance_from_edge(stance.reach_depth + 0.04) == pytest.approx(stance.standoff - 0.04)
     deepest = stance.reach_depth + stance.standoff - stance.closest
     assert distance_from_edge(deepest) == pytest.approx(stance.closest)
+    assert deepest_reach(base) == pytest.approx(deepest)  # what bt-eval's spots keep within
+    assert deepest_reach(load_robot_config("wheeled_humanoid").base) == MAX_DEPTH
     # beyond, from no edge: the message names how far the arm reaches
     wide = SupportSurface("wide", np.array([[1.0, -1.0], [4.0, 1.0]]), 0.75)
     with pytest.raises(StanceError, match=f"the arm reaches {deepest:.2f} m"):

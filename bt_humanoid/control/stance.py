@@ -92,3 +92,12 @@ def working_stance(
         hand_lateral=stance.hand_lateral,
         closest=stance.closest,
     )
+
+
+def deepest_reach(base: BaseConfig) -> float:
+    """How far behind a surface's edge the robot's hand reaches from its working stance (robot.yaml
+    ``base.working_stance``): its reach depth, plus what coming nearer than the standoff adds."""
+    stance = base.working_stance
+    if stance.closest is None or stance.standoff is None:
+        return stance.reach_depth
+    return stance.reach_depth + max(stance.standoff - stance.closest, 0.0)

@@ -22,6 +22,7 @@ import numpy as np
 from bt_humanoid.benchmarks.navigation import free_start
 from bt_humanoid.commanding import plan_command
 from bt_humanoid.control.motion import REST_SPEED
+from bt_humanoid.control.stance import deepest_reach
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.engine.verdict import check_condition
@@ -142,10 +143,11 @@ def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> RobotStack:
     if draw.start_surface is None or not draw.obj:
         return run
     surface = run.context.world_model.surface(draw.start_surface)
-    footprint, bounds = run.context.robot_config.base.footprint_radius, np.array(world.bounds)
+    base = run.context.robot_config.base
+    footprint, bounds = base.footprint_radius, np.array(world.bounds)
 
-    def spot_among(others: list[np.ndarray]) -> np.ndarray:
-        return reachable_spot(surface, probe.navigator.grid, footprint, bounds, others, rng)
+    def spot_among(others: list[np.ndarray]) -> np.ndarray:  # where this robot's hand reaches
+        return reachable_spot(surface, probe.navigator.grid, footprint, bounds, others, rng, deepest_reach(base))
 
     objects = list(run.sim.object_bodies)  # the run's: the world's fixed bodies, or its scene's
     if suite.randomize.scene is None:  # a random scene already put it at a reachable spot on that surface
@@ -171,6 +173,7 @@ def _random_scene(suite: Suite, draw: Draw, probe: RobotStack, base: SceneConfig
     rng, world = draw.rng, probe.world
     belief = probe.context.world_model
     footprint, bounds = probe.context.robot_config.base.footprint_radius, np.array(world.bounds)
+    depth = deepest_reach(probe.context.robot_config.base)
     fewest, most = settings.objects
     count = int(rng.integers(fewest, most + 1))
     among = settings.among or world.placeable
@@ -186,7 +189,7 @@ def _random_scene(suite: Suite, draw: Draw, probe: RobotStack, base: SceneConfig
         on = draw.start_surface if first else str(rng.choice(settings.surfaces))
         surface = belief.surface(on)
         try:
-            spot = reachable_spot(surface, probe.navigator.grid, footprint, bounds, taken, rng)
+            spot = reachable_spot(surface, probe.navigator.grid, footprint, bounds, taken, rng, depth)
         except ValueError:
             if index == 0 and draw.obj:
                 raise

@@ -29,8 +29,10 @@ def reachable_spot(
     bounds: np.ndarray,
     others: list[np.ndarray],
     rng: np.random.Generator,
+    max_depth: float = MAX_DEPTH,
 ) -> np.ndarray:
-    """A random (x, y) on ``surface`` that the right hand reaches from every free stance beside it.
+    """A random (x, y) on ``surface`` that the right hand reaches from every free stance beside it: at most
+    ``max_depth`` behind the edge (less some slack; the robot's ``deepest_reach``).
 
     The spot keeps ``EDGE_MARGIN`` from the edges, ``SPACING`` from ``others``, and each edge it can be
     reached across has a stance with free floor around the base.
@@ -47,7 +49,7 @@ def reachable_spot(
         depths = [spot[0] - x0, x1 - spot[0], spot[1] - y0, y1 - spot[1]]
         reached, blocked = 0, False
         for depth, direction in zip(depths, outward, strict=True):
-            if depth > MAX_DEPTH - REACH_SLACK:
+            if depth > max_depth - REACH_SLACK:
                 continue
             try:
                 x, y, yaw = stance_for(spot, surface, "right", footprint, bounds, centre + 3.0 * direction)
