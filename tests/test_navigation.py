@@ -14,6 +14,7 @@ from bt_humanoid.navigation.navigator import OBSERVED_MEMORY
 from bt_humanoid.navigation.occupancy import OccupancyGrid
 from bt_humanoid.navigation.planner import SAMPLE_SPACING, Clearance, PlanError, Route, plan_route
 from bt_humanoid.sim.robot_config import load_robot_config
+from bt_humanoid.skills.navigation_skills import back_up
 from bt_humanoid.testing.scenario import Scenario, build_run
 
 PLACES = {"table": (2.4, 0.0), "counter": (7.75, 2.5), "shelf": (1.2, 3.45), "kitchen": (7.0, 2.4)}
@@ -323,6 +324,24 @@ def test_back_up_refuses_when_the_map_shows_a_wall_behind():
     scenario = Scenario(run, run.execute())
     assert scenario.result.tree_status == "FAILURE"
     assert "no room to back up 0.50 m" in scenario.result.cause
+
+
+def test_a_biped_at_its_working_stance_may_back_away_from_the_table_but_not_into_a_wall():
+    """It works 0.18 to 0.25 m from a table's edge, inside its 0.36 m footprint's clearance: backing away, the
+    clearance only grows (a search folded the arms over the table, and a wrist stuck on it, when this was
+    refused)."""
+
+    def backing(start: tuple[float, float, float], distance: float):
+        run = build_run(
+            {"world": "apartment", "robot": "biped_humanoid", "mission": "b", "tree": {"wait": {"seconds": 1}}},
+            robot_start=start,
+        )
+        handle = back_up(run.stack.context, distance)
+        run.stack.close()
+        return handle
+
+    assert backing((2.62, 0.39, 0.0), 0.35) is not None  # its nearest working stance: 0.18 m from the table
+    assert backing((0.0, -4.1, 90.0), 0.5) is None  # a wall behind, as for the wheeled robot
 
 
 @pytest.mark.sim

@@ -274,8 +274,13 @@ def back_up(context: SkillContext, distance: float) -> MotionHandle | None:
     navigator = context.navigator
     x, y, yaw = context.robot.base.pose()
     behind = np.array([x, y]) - distance * np.array([math.cos(yaw), math.sin(yaw)])
+    if navigator is None:
+        return None
     path = np.linspace([x, y], behind, 20)[5:]  # the first points are where the robot stands
-    if navigator is None or np.any(navigator.grid.clearance_at(path) < navigator.clearance.minimum):
+    # a walking robot works nearer a table than a route may pass it: backing away, the clearance only grows, so
+    # the way back is free where it keeps at least what the robot has where it stands
+    here = float(navigator.grid.clearance_at(np.array([[x, y]]))[0])
+    if np.any(navigator.grid.clearance_at(path) < min(navigator.clearance.minimum, here)):
         return None
     return context.robot.base.move_to(behind[0], behind[1], yaw, max_speed=BACK_UP_SPEED)
 
