@@ -44,3 +44,16 @@ def test_the_biped_comes_nearer_for_a_deeper_spot_down_to_its_closest():
     wide = SupportSurface("wide", np.array([[1.0, -1.0], [4.0, 1.0]]), 0.75)
     with pytest.raises(StanceError, match=f"the arm reaches {deepest:.2f} m"):
         working_stance(np.array([2.4, 0.0]), wide, "right", base, BOUNDS, SOUTH)
+
+
+@pytest.mark.parametrize("closest", [None, 0.3])
+def test_the_deepest_reach_is_where_the_working_stance_stops_reaching(closest):
+    """With or without a closest stance, and with the standoff left to the footprint (the wheeled robot's)."""
+    base = load_robot_config("wheeled_humanoid").base
+    base = base.model_copy(update={"working_stance": base.working_stance.model_copy(update={"closest": closest})})
+    deep = SupportSurface("deep", np.array([[1.0, -3.0], [4.0, 0.45]]), 0.75)  # reached from its north edge only
+    deepest = deepest_reach(base)
+    north = np.array([2.4, 3.0])
+    working_stance(np.array([2.4, 0.45 - deepest + 0.005]), deep, "right", base, BOUNDS, north)
+    with pytest.raises(StanceError):
+        working_stance(np.array([2.4, 0.45 - deepest - 0.005]), deep, "right", base, BOUNDS, north)

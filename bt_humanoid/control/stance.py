@@ -46,7 +46,7 @@ def stance_for(
     x, y = float(spot[0]), float(spot[1])
     standoff = footprint_radius + EDGE_CLEARANCE if standoff is None else standoff
     nearest = standoff if closest is None else min(closest, standoff)
-    reach = max_depth + standoff - nearest
+    reach = _reach(max_depth, standoff, closest)
     # (depth of the spot behind the edge, the edge's point on the line through the spot, facing yaw)
     edges = [(x - x0, (x0, y), 0.0), (x1 - x, (x1, y), math.pi), (y - y0, (x, y0), math.pi / 2)]
     edges.append((y1 - y, (x, y1), -math.pi / 2))
@@ -96,8 +96,12 @@ def working_stance(
 
 def deepest_reach(base: BaseConfig) -> float:
     """How far behind a surface's edge the robot's hand reaches from its working stance (robot.yaml
-    ``base.working_stance``): its reach depth, plus what coming nearer than the standoff adds."""
+    ``base.working_stance``): what ``working_stance`` refuses beyond."""
     stance = base.working_stance
-    if stance.closest is None or stance.standoff is None:
-        return stance.reach_depth
-    return stance.reach_depth + max(stance.standoff - stance.closest, 0.0)
+    standoff = base.footprint_radius + EDGE_CLEARANCE if stance.standoff is None else stance.standoff
+    return _reach(stance.reach_depth, standoff, stance.closest)
+
+
+def _reach(max_depth: float, standoff: float, closest: float | None) -> float:
+    """The deepest spot reached: ``max_depth`` from ``standoff``, deeper by what coming to ``closest`` adds."""
+    return max_depth + (max(standoff - closest, 0.0) if closest is not None else 0.0)

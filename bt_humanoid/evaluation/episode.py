@@ -144,10 +144,10 @@ def _set_up(suite: Suite, draw: Draw, record: dict[str, Any]) -> RobotStack:
         return run
     surface = run.context.world_model.surface(draw.start_surface)
     base = run.context.robot_config.base
-    footprint, bounds = base.footprint_radius, np.array(world.bounds)
+    footprint, bounds, depth = base.footprint_radius, np.array(world.bounds), deepest_reach(base)
 
     def spot_among(others: list[np.ndarray]) -> np.ndarray:  # where this robot's hand reaches
-        return reachable_spot(surface, probe.navigator.grid, footprint, bounds, others, rng, deepest_reach(base))
+        return reachable_spot(surface, probe.navigator.grid, footprint, bounds, others, rng, depth)
 
     objects = list(run.sim.object_bodies)  # the run's: the world's fixed bodies, or its scene's
     if suite.randomize.scene is None:  # a random scene already put it at a reachable spot on that surface

@@ -164,13 +164,11 @@ class RouteFollower:
         """The speed a base slower sideways than forwards makes along the route facing ``yaw``: on the ellipse of
         its forward and sideways speeds. Turning to the goal's yaw on the last stretch, a walking base was asked
         to go sideways at the route's speed, fell 0.3 m behind, and ran out of time side-stepping to the goal."""
-        limits = self.config.limits
-        assert limits.max_sideways_speed is not None
         along = self._point(route, s)[1]
         if not np.any(along):
             return math.inf
         angle = math.atan2(along[1], along[0]) - yaw
-        forward, sideways = math.cos(angle) / self.max_speed, math.sin(angle) / limits.max_sideways_speed
+        forward, sideways = math.cos(angle) / self.max_speed, math.sin(angle) / self.config.limits.sideways_speed
         return 1.0 / math.hypot(forward, sideways)
 
     def _heading_target(self, route: Route, s: float, index: int) -> float:
@@ -218,7 +216,7 @@ class RouteFollower:
             # a slow base (a biped turning at 0.3 rad/s, side-stepping at 0.08 m/s, a step at a time) gets the
             # time its last turn and its last steps take as well, at its slowest
             limits = self.config.limits
-            slowest = min(limits.max_speed, limits.max_sideways_speed or limits.max_speed)
+            slowest = min(limits.max_speed, limits.sideways_speed)
             self.settle_time = SETTLE_TIMEOUT + yaw_error / limits.max_yaw_rate + remaining / slowest
         settle = self.settle_time
         if arrived:  # within tolerance and coming to rest: as long again for its last steps

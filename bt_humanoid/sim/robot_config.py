@@ -31,6 +31,11 @@ class BaseLimits(StrictModel):
     #: m/s the base moves sideways to its heading; None: as fast as forwards (a wheeled base)
     max_sideways_speed: float | None = Field(None, gt=0)
 
+    @property
+    def sideways_speed(self) -> float:
+        """m/s the base makes sideways to its heading (its forward speed where it says none)."""
+        return self.max_sideways_speed if self.max_sideways_speed is not None else self.max_speed
+
 
 class BaseTolerance(StrictModel):
     position: float = 0.02

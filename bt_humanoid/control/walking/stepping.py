@@ -101,8 +101,9 @@ def capture_step(
         return limits.clip(wanted(soonest), stance), soonest
     best: tuple[float, float, Footstep] | None = None
     for duration in np.linspace(remaining, soonest, TIMING_CANDIDATES):
-        target = limits.clip(wanted(duration), stance)
-        miss = float(np.linalg.norm(target.position - wanted(duration).position))
+        step = wanted(duration)
+        target = limits.clip(step, stance)
+        miss = float(np.linalg.norm(target.position - step.position))
         if best is None or miss < best[0] - REACH_TOLERANCE:
             best = (miss, float(duration), target)
         if miss <= REACH_TOLERANCE:

@@ -197,7 +197,6 @@ class WalkingBase(SpeedMonitoring):
         speed = float(np.hypot(body[0], body[1]))
         if speed > self.capped():
             body[:2] *= self.capped() / speed
-        sideways = limits.max_sideways_speed if limits.max_sideways_speed is not None else limits.max_speed
-        body[1] = float(np.clip(body[1], -sideways, sideways))
+        body[1] = float(np.clip(body[1], -limits.sideways_speed, limits.sideways_speed))
         body[2] = float(np.clip(body[2], -limits.max_yaw_rate, limits.max_yaw_rate))
         self.walker.command(*body)
