@@ -3,15 +3,16 @@
 import numpy as np
 import pytest
 
+from bt_humanoid.benchmarks.common import footing_removed, has_fallen
 from bt_humanoid.benchmarks.manipulation import OBJECTS, SURFACE, run_trial, sample_trial
-from bt_humanoid.control.stance import stance_for
+from bt_humanoid.control.stance import deepest_reach, working_stance
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.testing.scene import place_object
 from bt_humanoid.testing.told import told_objects
 
 
-def _table():
-    stack = RobotStack.load("apartment", "wheeled_humanoid")
+def _table(robot: str = "wheeled_humanoid"):
+    stack = RobotStack.load("apartment", robot)
     return stack, stack.context.world_model.surface(SURFACE)
 
 
@@ -25,28 +26,43 @@ def test_place_object_moves_the_declared_and_the_simulated_pose_together():
     assert abs(belief.yaw - 0.7) < 1e-6
 
 
-def test_sampled_trials_stand_on_the_edge_they_were_drawn_for():
-    run, table = _table()
+@pytest.mark.parametrize("robot", ["wheeled_humanoid", "biped_humanoid"])
+def test_sampled_trials_stand_on_the_edge_they_were_drawn_for_within_the_robots_reach(robot):
+    run, table = _table(robot)
     rng = np.random.default_rng(3)
     bounds = np.array(run.context.world.bounds)
-    footprint = run.context.robot_config.base.footprint_radius
-    for kind in OBJECTS:
-        trial = sample_trial(kind, table, bounds, footprint, rng)
+    base = run.context.robot_config.base
+    (x0, y0), (x1, _) = table.region
+    for kind in list(OBJECTS) * 4:
+        trial = sample_trial(kind, table, bounds, base, rng)
         assert table.contains(np.array(trial.spot), margin=0.09) and table.contains(np.array(trial.place), margin=0.09)
         assert np.hypot(trial.spot[0] - trial.place[0], trial.spot[1] - trial.place[1]) >= 0.15
         for spot in (trial.spot, trial.place):
-            _, _, yaw = stance_for(np.array(spot), table, "right", footprint, bounds, np.array(trial.start[:2]))
+            _, _, yaw = working_stance(np.array(spot), table, "right", base, bounds, np.array(trial.start[:2]))
             assert abs(np.degrees(yaw) - trial.start[2]) < 1e-6
+            x, y = spot
+            behind_edge = {"west": x - x0, "east": x1 - x, "south": y - y0}[trial.edge]
+            assert behind_edge <= deepest_reach(base) - 0.06 + 1e-3  # the biped reaches less deep than the wheels
+
+
+def test_a_fall_is_the_pelvis_low_or_anything_but_a_sole_on_the_floor():
+    standing = [("l_sole_0", "floor"), ("r_foot", "floor"), ("r_pad", "red cube")]
+    assert footing_removed(standing) == [("r_pad", "red cube")]
+    assert not has_fallen(0.62, footing_removed(standing))
+    assert has_fallen(0.62, footing_removed([*standing, ("l_hand", "floor")]))  # a hand down
+    assert has_fallen(0.3, [])  # sitting on the floor
 
 
 @pytest.mark.sim
 def test_a_bottle_trial_is_picked_and_placed_upright_and_judged_so():
     run, table = _table()
-    trial = sample_trial("bottle", table, np.array(run.context.world.bounds), 0.32, np.random.default_rng(7))
+    base = run.context.robot_config.base
+    trial = sample_trial("bottle", table, np.array(run.context.world.bounds), base, np.random.default_rng(7))
     outcome = run_trial(trial)
     assert outcome.grasped and outcome.placed, outcome.failure
     assert outcome.error_cm < 3.0
     assert len(outcome.qp_times) > 100  # the whole-body QP ran and was timed at every control step
+    assert not outcome.fell
 
 
 def test_the_table_says_what_each_rate_is_counted_over():
@@ -55,7 +71,8 @@ def test_the_table_says_what_each_rate_is_counted_over():
     trial = Trial("mug", "west", (2.9, 0.1), 0.0, (2.9, -0.1), (2.2, 0.0, 0.0))
 
     def outcome(grasped: bool, placed: bool) -> Outcome:
-        return Outcome(grasped, placed, 0.3 if placed else None, None if placed else "missed", 10.0, [], [])
+        failure = None if placed else "missed"
+        return Outcome(grasped, placed, 0.3 if placed else None, failure, 10.0, fell=False, qp_times=[], conic_times=[])
 
     outcomes = [outcome(True, True)] * 3 + [outcome(True, False), outcome(False, False)]
     header, row = table([summarize("mug", [trial] * 5, outcomes)]).splitlines()

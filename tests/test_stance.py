@@ -57,3 +57,19 @@ def test_the_deepest_reach_is_where_the_working_stance_stops_reaching(closest):
     working_stance(np.array([2.4, 0.45 - deepest + 0.005]), deep, "right", base, BOUNDS, north)
     with pytest.raises(StanceError):
         working_stance(np.array([2.4, 0.45 - deepest - 0.005]), deep, "right", base, BOUNDS, north)
+
+
+def test_after_a_short_reach_the_biped_stands_nearer_by_as_much_but_not_past_its_closest():
+    base = load_robot_config("biped_humanoid").base
+    stance = base.working_stance
+    spot = np.array([2.4, -0.45 + 0.1])  # shallow: the biped stands at its standoff
+
+    def distance_from_edge(nearer: float, robot: str = "biped_humanoid") -> float:
+        config = load_robot_config(robot).base
+        return -0.45 - working_stance(spot, TABLE, "right", config, BOUNDS, SOUTH, nearer=nearer)[1]
+
+    assert distance_from_edge(0.0) == pytest.approx(stance.standoff)
+    assert distance_from_edge(0.04) == pytest.approx(stance.standoff - 0.04)
+    assert distance_from_edge(1.0) == pytest.approx(stance.closest)
+    # the wheeled robot has no closest stance: it stands where it stood (its base helps the arm instead)
+    assert distance_from_edge(0.04, "wheeled_humanoid") == pytest.approx(distance_from_edge(0.0, "wheeled_humanoid"))

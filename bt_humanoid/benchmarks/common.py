@@ -42,3 +42,22 @@ def save_figures(path: Path | None, figures: dict) -> None:
     """Write the figures as JSON when ``--json PATH`` was given."""
     if path is not None:
         path.write_text(json.dumps(figures, indent=2) + "\n")
+
+
+FALLEN_HEIGHT = 0.35  # m: a legged robot's pelvis below this has fallen
+
+
+def on_a_foot(geom: str) -> bool:
+    """A geom of a foot: its sole's corners or its box (which touches the floor when the foot rolls 3°)."""
+    return "_sole_" in geom or geom in ("l_foot", "r_foot")
+
+
+def footing_removed(touching: list[tuple[str, str]]) -> list[tuple[str, str]]:
+    """The robot's contacts (robot geom, other geom) less its soles on the floor: those are its footing."""
+    return [(mine, other) for mine, other in touching if not (on_a_foot(mine) and other == "floor")]
+
+
+def has_fallen(pelvis_height: float, touching: list[tuple[str, str]]) -> bool:
+    """In ground truth, a legged robot is down: its pelvis low, or something other than a sole on the floor
+    (``touching`` without the footing)."""
+    return pelvis_height < FALLEN_HEIGHT or any(other == "floor" for _, other in touching)

@@ -14,8 +14,10 @@ placements of the grasped trials (a trial that never held the object is not
 a placement attempt) and of all trials. Also prints the whole-body QP time
 per control step. The
 robot finds the object with its head camera; ``--perception told`` tells it
-where the object is instead, to measure control alone. Runs pinned to one
-CPU core; ``--json PATH`` also writes the figures.
+where the object is instead, to measure control alone. ``--robot
+biped_humanoid`` runs the walking robot: spots are drawn within its own
+reach (robot.yaml ``base.working_stance``) and falls are counted, in ground
+truth. Runs pinned to one CPU core; ``--json PATH`` also writes the figures.
 """
 
 from __future__ import annotations
@@ -27,11 +29,20 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
-from bt_humanoid.control.stance import MAX_DEPTH, stance_for
+from bt_humanoid.benchmarks.common import (
+    benchmark_parser,
+    footing_removed,
+    has_fallen,
+    parse_benchmark_args,
+    percentile,
+    save_figures,
+)
+from bt_humanoid.control.stance import deepest_reach, working_stance
 from bt_humanoid.engine.stack import RobotStack
+from bt_humanoid.paths import robots_dir
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.world_model import SupportSurface
+from bt_humanoid.sim.robot_config import BaseConfig
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 from bt_humanoid.testing.told import tell_object_poses
@@ -65,6 +76,7 @@ class Outcome:
     error_cm: float | None
     failure: str | None
     sim_time: float
+    fell: bool
     qp_times: list[float]
     conic_times: list[float]
 
@@ -81,25 +93,27 @@ def _edge_frame(surface: SupportSurface, edge: str) -> tuple[np.ndarray, np.ndar
     raise ValueError(f"unknown edge {edge!r}")
 
 
-def sample_trial(kind: str, surface: SupportSurface, bounds: np.ndarray, footprint: float, rng) -> Trial:
-    """A random spot, yaw and placement spot on one edge, and a start pose from which that edge is nearest."""
+def sample_trial(kind: str, surface: SupportSurface, bounds: np.ndarray, base: BaseConfig, rng) -> Trial:
+    """A random spot, yaw and placement spot on one edge within the robot's reach (its ``base``), and a start
+    pose from which that edge is nearest."""
+    depth = deepest_reach(base)
     while True:
         edge = EDGES[int(rng.integers(len(EDGES)))]
         corner, inward, along, length = _edge_frame(surface, edge)
 
         pick, place = (
             corner
-            + rng.uniform(MIN_DEPTH, MAX_DEPTH - 0.06) * inward
+            + rng.uniform(MIN_DEPTH, depth - 0.06) * inward
             + rng.uniform(CORNER_MARGIN, length - CORNER_MARGIN) * along
             for _ in range(2)
         )
         if np.linalg.norm(pick - place) < SPACING:
             continue
         far = pick - 3.0 * inward
-        x, y, yaw = stance_for(pick, surface, SIDE, footprint, bounds, far)
+        x, y, yaw = working_stance(pick, surface, SIDE, base, bounds, far)
         start = np.array([x, y]) - START_BACK * np.array([math.cos(yaw), math.sin(yaw)])
         # stand_near picks the reachable edge nearest the robot: make sure it is this one, for both spots
-        if any(abs(stance_for(p, surface, SIDE, footprint, bounds, start)[2] - yaw) > 1e-6 for p in (pick, place)):
+        if any(abs(working_stance(p, surface, SIDE, base, bounds, start)[2] - yaw) > 1e-6 for p in (pick, place)):
             continue
         return Trial(
             kind,
@@ -111,12 +125,13 @@ def sample_trial(kind: str, surface: SupportSurface, bounds: np.ndarray, footpri
         )
 
 
-def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
+def prepare_trial(trial: Trial, perception: str = "camera", robot: str = "wheeled_humanoid") -> RobotStack:
+    """The trial's run, ready to execute: its object at its spot, the others parked on the counter."""
     name = OBJECTS[trial.kind]
     mission = {
         "mission": f"benchmark: pick and place the {name}",
         "world": "apartment",
-        "robot": "wheeled_humanoid",
+        "robot": robot,
         "tree": {
             "sequence": [
                 {"pick": {"object": name, "side": SIDE}},
@@ -134,6 +149,12 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
     place_object(run, name, *trial.spot, trial.yaw)
     if perception == "told":  # control alone: the robot is told where everything is (the camera still looks)
         tell_object_poses(run.context.world_model, run.sim)
+    return run
+
+
+def run_trial(trial: Trial, perception: str = "camera", robot: str = "wheeled_humanoid") -> Outcome:
+    name = OBJECTS[trial.kind]
+    run = prepare_trial(trial, perception, robot)
     grasped: list[bool] = []
 
     def on_event(event: dict) -> None:
@@ -141,6 +162,14 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
             grasped.append(event["new"] == "SUCCESS" and run.truth.in_hand(name) == SIDE)
 
     run.events.listeners.append(on_event)
+    fell = False
+
+    def watch_balance() -> None:  # a legged robot that goes down, in ground truth
+        nonlocal fell
+        fell = fell or has_fallen(run.truth.floating_base()[0][2], footing_removed(run.truth.robot_contacts()))
+
+    if run.sim.robot.base.floating:
+        run.executor.observers.append(watch_balance)
     result = run.execute()
     run.stack.close()  # its cameras' off-screen contexts: one per run adds up over a benchmark
     truth = run.truth
@@ -161,12 +190,14 @@ def run_trial(trial: Trial, perception: str = "camera") -> Outcome:
         failure = f"safety stop: {result.safety}" if result.safety else failure  # which monitor fired, and why
         if result.tree_status == "SUCCESS":
             failure = f"ended {error * 100:.1f} cm from the spot" + ("" if upright else ", tipped over")
+        failure = f"fell ({failure})" if fell else failure
     return Outcome(
         grasped=bool(grasped and grasped[0]),
         placed=placed,
         error_cm=round(error * 100, 2) if grasped and grasped[0] else None,
         failure=failure,
         sim_time=result.sim_time,
+        fell=fell,
         qp_times=list(run.robot.whole_body.solve_times),
         conic_times=list(run.robot.whole_body.conic_times),
     )
@@ -185,6 +216,8 @@ def summarize(kind: str, trials: list[Trial], outcomes: list[Outcome]) -> dict:
         "place_success": len(placed) / len(grasped) if grasped else 0.0,  # of the grasped trials
         "end_to_end": len(placed) / len(outcomes),  # placed, of all trials
         "median_place_error_cm": statistics.median(errors) if errors else None,  # over the placed trials
+        "falls": sum(1 for o in outcomes if o.fell),
+        "sim_time_s": round(sum(o.sim_time for o in outcomes), 1),
         "failures": [
             {"trial": asdict(t), "failure": o.failure} for t, o in zip(trials, outcomes, strict=True) if not o.placed
         ],
@@ -215,24 +248,26 @@ def main(argv: list[str] | None = None) -> int:
         default="camera",
         help="objects known only once the head camera has seen them (default), or told where they are",
     )
+    robots = sorted(path.name for path in robots_dir().iterdir() if (path / "robot.yaml").exists())
+    parser.add_argument("--robot", choices=robots, default="wheeled_humanoid", help="the robot that works")
     args = parse_benchmark_args(parser, argv, "trials")
     rng = np.random.default_rng(args.seed)
-    probe = RobotStack.load("apartment", "wheeled_humanoid")  # the apartment's surfaces, for drawing trials
+    probe = RobotStack.load("apartment", args.robot)  # the apartment's surfaces and the robot's reach
     probe.close()
     surface = probe.context.world_model.surface(SURFACE)
     bounds = np.array(probe.world.bounds)
-    footprint = probe.robot_config.base.footprint_radius
+    base = probe.robot_config.base
     print(
-        f"bt-humanoid manipulation benchmark: {args.trials} trials per kind, seed {args.seed}, "
+        f"bt-humanoid manipulation benchmark: {args.robot}, {args.trials} trials per kind, seed {args.seed}, "
         f"perception {args.perception} (one core)"
     )
     started = time.perf_counter()
     summaries, qp_times, conic_times = [], [], []
     for kind in args.kinds:
-        trials = [sample_trial(kind, surface, bounds, footprint, rng) for _ in range(args.trials)]
+        trials = [sample_trial(kind, surface, bounds, base, rng) for _ in range(args.trials)]
         outcomes = []
         for i, trial in enumerate(trials, 1):
-            outcome = run_trial(trial, args.perception)
+            outcome = run_trial(trial, args.perception, args.robot)
             outcomes.append(outcome)
             qp_times.extend(outcome.qp_times)
             conic_times.extend(outcome.conic_times)
@@ -241,7 +276,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {kind} {i}/{len(trials)}  {where}: {verdict}", flush=True)
         summaries.append(summarize(kind, trials, outcomes))
     qp_ms = [t * 1000 for t in qp_times]
+    sim_time = sum(s["sim_time_s"] for s in summaries)
     figures = {
+        "robot": args.robot,
+        "perception": args.perception,
         "seed": args.seed,
         "kinds": summaries,
         "qp_steps": len(qp_ms),
@@ -249,6 +287,8 @@ def main(argv: list[str] | None = None) -> int:
         "qp_p95_ms": percentile(qp_ms, 0.95),
         "conic_median_ms": statistics.median(conic_times) * 1000,
         "wall_s": round(time.perf_counter() - started, 1),
+        "falls": sum(s["falls"] for s in summaries),
+        "real_time_factor": round(sim_time / (time.perf_counter() - started), 2),
     }
     print()
     print(table(summaries))
@@ -257,7 +297,8 @@ def main(argv: list[str] | None = None) -> int:
         f"p95 {figures['qp_p95_ms']:.3f} ms over {figures['qp_steps']} steps (target ≤ 0.5 ms); "
         f"of it in the conic solver: median {figures['conic_median_ms']:.3f} ms"
     )
-    print(f"  wall time {figures['wall_s']:.0f} s")
+    print(f"  falls: {figures['falls']} (target 0)")
+    print(f"  wall time {figures['wall_s']:.0f} s, {figures['real_time_factor']:.1f}× real time on one core")
     save_figures(args.json, figures)
     return 0
 

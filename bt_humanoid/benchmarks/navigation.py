@@ -28,8 +28,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
-from bt_humanoid.benchmarks.walking import on_a_foot
+from bt_humanoid.benchmarks.common import (
+    benchmark_parser,
+    footing_removed,
+    has_fallen,
+    parse_benchmark_args,
+    percentile,
+    save_figures,
+)
 from bt_humanoid.engine.stack import RobotStack
 from bt_humanoid.navigation.grid_astar import grid_route_length
 from bt_humanoid.testing.scenario import build_run
@@ -39,7 +45,6 @@ START_CLEARANCE = 0.8  # m of free floor around a random start: the arms of the 
 #: m and degrees a run must end within, per robot (a biped's goals are footsteps: issue 24 asks for 10 cm, 10°)
 TOLERANCES = {"wheeled_humanoid": (0.05, 5.0), "biped_humanoid": (0.10, 10.0)}
 SPEED = 0.8  # m/s cap for the drive (the biped's base limits it to 0.35)
-FALLEN_HEIGHT = 0.35  # m: a legged robot's pelvis below this has fallen
 MOVING = 0.02  # m/s: the base counts as driving above this speed
 
 
@@ -105,8 +110,8 @@ def run_one(
         nonlocal fell
         touching = run.truth.robot_contacts()
         if floating:  # a biped stands on its soles: those contacts with the floor are its footing
-            touching = [(mine, other) for mine, other in touching if not (on_a_foot(mine) and other == "floor")]
-            fell = fell or run.truth.floating_base()[0][2] < FALLEN_HEIGHT or any(o == "floor" for _, o in touching)
+            touching = footing_removed(touching)
+            fell = fell or has_fallen(run.truth.floating_base()[0][2], touching)
         contacts.extend(touching)
         x, y, _ = run.truth.robot_pose()
         track.append((run.sim.time, np.array([x, y]), float(np.hypot(*run.robot.base.speeds()[:2]))))

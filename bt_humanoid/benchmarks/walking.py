@@ -28,7 +28,7 @@ import time
 
 import numpy as np
 
-from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, percentile, save_figures
+from bt_humanoid.benchmarks.common import benchmark_parser, on_a_foot, parse_benchmark_args, percentile, save_figures
 from bt_humanoid.control.walking.walker import Phase, WalkingController
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.robot_config import load_robot_config
@@ -41,11 +41,6 @@ STANDING_HEIGHT = 0.4  # m: a pelvis below this has fallen
 PUSH_TIME = 0.2  # s
 SETTLE = 3.0  # s after a push before judging
 LOWEST, HIGHEST, RESOLUTION = 50.0, 400.0, 5.0  # N: the largest-push bisection's bracket and resolution
-
-
-def on_a_foot(geom: str) -> bool:
-    """A geom of a foot: its sole's corners or its box (which touches the floor when the foot rolls 3°)."""
-    return "_sole_" in geom or geom in ("l_foot", "r_foot")
 
 
 class Fell(Exception):

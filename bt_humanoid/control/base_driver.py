@@ -50,6 +50,7 @@ class BaseDriver(SpeedMonitoring):
         self.handle: MotionHandle | None = None
         self.trajectory: Trajectory | None = None
         self.target = self.reference.copy()
+        self.arrival = config.tolerance.position  # m: the goal counts as reached this near (move_to's tolerance)
         self.braking = False
         self.tracking = False  # following references streamed by the whole-body controller
         self.limiter = None  # slows planned motions near people and things sensed
@@ -79,7 +80,13 @@ class BaseDriver(SpeedMonitoring):
         return True  # the planar joints stop where they are
 
     def move_to(
-        self, x: float, y: float, yaw: float, max_speed: float | None = None, shortest_turn: bool = True
+        self,
+        x: float,
+        y: float,
+        yaw: float,
+        max_speed: float | None = None,
+        shortest_turn: bool = True,
+        tolerance: float | None = None,
     ) -> MotionHandle:
         """Start driving to a world pose; returns the handle to poll.
 
@@ -105,6 +112,7 @@ class BaseDriver(SpeedMonitoring):
         self._begin_plan()
         self.planned_velocity = self.velocity.copy()
         self.target = target
+        self.arrival = self.config.tolerance.position if tolerance is None else tolerance
         self.braking = self.tracking = False
         self.handle = MotionHandle(f"driving {distance:.2f} m", on_cancel=lambda _: self.brake())
         return self.handle
@@ -197,8 +205,7 @@ class BaseDriver(SpeedMonitoring):
             return
         if elapsed < self.trajectory.duration:
             return
-        tolerance = self.config.tolerance
-        if remaining < tolerance.position and math.degrees(yaw_error) < tolerance.yaw_deg:
+        if remaining < self.arrival and math.degrees(yaw_error) < self.config.tolerance.yaw_deg:
             handle.succeed(f"arrived within {remaining * 100:.1f} cm, {math.degrees(yaw_error):.1f}°")
             self.handle = None
         elif elapsed > self.trajectory.duration + SETTLE_TIMEOUT:

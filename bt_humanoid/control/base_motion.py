@@ -41,9 +41,16 @@ class BaseMotion(Protocol):
         ...
 
     def move_to(
-        self, x: float, y: float, yaw: float, max_speed: float | None = None, shortest_turn: bool = True
+        self,
+        x: float,
+        y: float,
+        yaw: float,
+        max_speed: float | None = None,
+        shortest_turn: bool = True,
+        tolerance: float | None = None,
     ) -> MotionHandle:
-        """A pose goal: drive there and stop."""
+        """A pose goal: drive there and stop, arrived within ``tolerance`` m (default: robot.yaml
+        ``base.tolerance.position``)."""
         ...
 
     def track(self, reference: np.ndarray, velocity: np.ndarray) -> None:

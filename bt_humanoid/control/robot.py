@@ -109,6 +109,15 @@ class RobotController:
                 if self.scale.carried(side) > 0.0 and not self.grippers.holding(side):
                     self.scale.carry(side, 0.0)
 
+    def weighs(self, side: str) -> bool:
+        """Whether ``weigh`` tells the ``side`` hand's load: a wrist sensor, and a balance that needs it."""
+        return self.scale is not None and side in self.scale.sensors
+
+    def load(self, side: str) -> float | None:
+        """What the ``side`` hand's wrist sensor reads it holds now (kg), without balancing with it; None
+        where ``weighs`` is false."""
+        return self.scale.weigh(side) if self.scale is not None and side in self.scale.sensors else None
+
     def weigh(self, side: str) -> float | None:
         """Weigh what the ``side`` hand holds (kg) and, on legs, balance with it from now until it lets go; None
         for a robot without a wrist sensor on that hand, or with no balance to tell (a wheeled base)."""

@@ -34,11 +34,13 @@ def stance_for(
     max_depth: float = MAX_DEPTH,
     hand_lateral: float = HAND_LATERAL,
     closest: float | None = None,
+    nearer: float = 0.0,
 ) -> tuple[float, float, float]:
     """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``: ``standoff`` m from
     the edge (default: the footprint ``EDGE_CLEARANCE`` clear of it), the spot at most ``max_depth`` behind it
     and ``hand_lateral`` to the working hand's side. With ``closest``, a deeper spot brings the stance nearer
-    the edge by as much, down to ``closest`` m from it: the hand then reaches as far ahead of the base.
+    the edge by as much, down to ``closest`` m from it: the hand then reaches as far ahead of the base; and
+    ``nearer`` m more (a hand that fell short from there), still not past ``closest``.
 
     Of the edges that reach the spot, the one whose stance is nearest the robot wins.
     """
@@ -54,7 +56,7 @@ def stance_for(
     options = []
     for depth, edge, yaw in edges:
         facing = np.array([math.cos(yaw), math.sin(yaw)])
-        distance = float(np.clip(standoff - (depth - max_depth), nearest, standoff))
+        distance = float(np.clip(min(standoff, standoff - (depth - max_depth)) - nearer, nearest, standoff))
         left = np.array([-math.sin(yaw), math.cos(yaw)])
         stance = np.array(edge) - distance * facing + lateral * left  # the spot on the working hand's side
         inside = np.all(stance >= bounds[0] + footprint_radius) and np.all(stance <= bounds[1] - footprint_radius)
@@ -76,9 +78,16 @@ def stance_for(
 
 
 def working_stance(
-    spot: np.ndarray, surface: SupportSurface, side: str, base: BaseConfig, bounds: np.ndarray, robot_xy: np.ndarray
+    spot: np.ndarray,
+    surface: SupportSurface,
+    side: str,
+    base: BaseConfig,
+    bounds: np.ndarray,
+    robot_xy: np.ndarray,
+    nearer: float = 0.0,
 ) -> tuple[float, float, float]:
-    """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml)."""
+    """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml), ``nearer`` m nearer the
+    edge where its ``closest`` allows."""
     stance = base.working_stance
     return stance_for(
         spot,
@@ -91,6 +100,7 @@ def working_stance(
         max_depth=stance.reach_depth,
         hand_lateral=stance.hand_lateral,
         closest=stance.closest,
+        nearer=nearer,
     )
 
 

@@ -70,6 +70,7 @@ class WholeBodyGoal:
     gaze_task: GazeTask | None = None
     tolerance: tuple[float, float] = (POSITION_TOLERANCE, ORIENTATION_TOLERANCE)
     stop_on_contact: bool = False
+    touched: Callable[[], bool] | None = None  # senses the contact that stops it; None: the hand's lag
     failures: int = 0  # consecutive unsolved QPs
     position_error: float | None = None  # measured, once the path has ended
 
@@ -145,12 +146,16 @@ class WholeBodyController:
         limits: list[Limit] | None = None,
         tolerance: tuple[float, float] = (POSITION_TOLERANCE, ORIENTATION_TOLERANCE),
         stop_on_contact: bool = False,
+        touched: Callable[[], bool] | None = None,
     ) -> MotionHandle:
         """Move ``side``'s hand to ``target`` in a straight line, the rest of the body helping.
 
-        With ``stop_on_contact`` the motion ends (successfully) as soon as the
-        measured hand lags its reference by ``CONTACT_LAG``: whatever it holds
-        has touched something, as when lowering an object onto a table.
+        With ``stop_on_contact`` the motion ends (successfully) as soon as
+        whatever the hand holds has touched something, as when lowering an
+        object onto a table: when ``touched()`` says so (a force sensor's
+        reading), or else when the measured hand lags its reference by
+        ``CONTACT_LAG`` (stiff arms only: a balancing robot's arm lags that
+        much just moving).
         """
         self._begin()
         frame = self.hand_frame(side)
@@ -202,6 +207,7 @@ class WholeBodyController:
             gaze_task=gaze_task,
             tolerance=tolerance,
             stop_on_contact=stop_on_contact,
+            touched=touched,
         )
         return handle
 
@@ -274,7 +280,7 @@ class WholeBodyController:
             self._update(self.measured, self.measured_positions())
             frame = goal.frame_task.frame
             lag = self.kinematics.pose(frame).translation - self.measured.pose(frame).translation
-            if np.linalg.norm(lag) > CONTACT_LAG:
+            if goal.touched() if goal.touched is not None else np.linalg.norm(lag) > CONTACT_LAG:
                 self.reference = self.measured_positions()  # stop pressing
                 self.base_target = self.base.pose()
                 self._finish(goal, True, "stopped on contact")

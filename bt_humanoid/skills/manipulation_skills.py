@@ -50,6 +50,11 @@ CARRY_TOLERANCE = (0.05, 0.2)  # m, rad: the carry pose needs no precision (a ta
 IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (and not behind it) hides part of it
 BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its line of sight is behind it
 ASIDE = 0.18  # m a hand in the camera's way moves outwards: out of a 20° cone at the arm's usual reach
+SHORT_REACH = 0.005  # m: a descent that stopped further than this short of its goal, ahead of the base, fell short
+STEP_IN = 0.04  # m nearer, at least, the next stance comes after a reach fell short: enough for the feet to step
+LIFT_OFF = 0.03  # m a robot that balances with what it holds lifts it to weigh it, before the lift proper
+LIFT_OFF_TOLERANCE = (0.03, 0.2)  # m, rad: off the surface is all that counts (the arm sags under a weight unknown)
+LOAD_TAKEN = 0.5  # share of a held thing's weight the wrist no longer feels when a surface bears it
 
 
 def carry_height(belief: WorldModel, held: TrackedObject | None) -> float:
@@ -116,6 +121,15 @@ class _ManipulationSkill(PhasedSkill):
         if held is not None:
             return held.grip_offset + float(held.size[2]) / 2, hand_radius(held, is_open=False)
         return PAD_HALF_HEIGHT, hand_radius(None, self._is_open(side))
+
+    def _note_short_reach(self, thing: TrackedObject, goal: np.ndarray) -> None:
+        """A hand that stopped short of ``goal``, ahead of the base, on its way down to take or put ``thing``
+        asks the next stance for it to come nearer (``StandNear``, where the robot's ``working_stance.closest``
+        allows): reaching further, a balancing robot would lean until it fell."""
+        _, _, yaw = self.context.robot.base.pose()
+        ahead = float((goal - self._hand_xyz(self.params.side))[:2] @ np.array([math.cos(yaw), math.sin(yaw)]))
+        if ahead > SHORT_REACH:
+            thing.reach_short += max(ahead + SHORT_REACH, STEP_IN)
 
     def _hand_xyz(self, side: str) -> np.ndarray:
         whole_body = self.context.robot.whole_body
@@ -268,6 +282,8 @@ class StandNear(_ManipulationSkill):
             surface = self._surface(p.surface)
             spot = np.array(p.at) if p.at is not None else surface.region.mean(axis=0)
         config = self.context.robot_config
+        worked_on = self._worked_on()
+        nearer = worked_on.reach_short if worked_on is not None else 0.0
         try:
             pose = working_stance(
                 spot,
@@ -276,10 +292,17 @@ class StandNear(_ManipulationSkill):
                 config.base,
                 np.array(self.context.world.bounds),
                 self.context.robot.base.pose()[:2],
+                nearer=nearer,
             )
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
         return surface, np.array(pose)
+
+    def _worked_on(self) -> TrackedObject | None:
+        """The object to take (``object``), or the one the hand holds to put down (at a surface spot)."""
+        if self.params.object is not None:
+            return self._object(self.params.object)
+        return self.context.world_model.held(self.params.side)
 
     def _tuck(self) -> MotionHandle:
         """Fold the idle arm inside the footprint, where no furniture edge can catch it."""
@@ -312,7 +335,11 @@ class StandNear(_ManipulationSkill):
         _surface, (x, y, yaw) = self._stance()
         if self._straight_way_blocked(np.array([x, y])):  # the object moved, or we stand on another side
             return self.context.navigator.go_to(np.array([x, y, yaw]), p.max_speed)
-        return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed)
+        # after a reach fell short, stepping in by a few centimetres is the point: arrive that precisely
+        worked_on = self._worked_on()
+        stepping_in = worked_on is not None and worked_on.reach_short > 0
+        tolerance = STEP_IN / 2 if stepping_in else None
+        return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed, tolerance=tolerance)
 
     def _straight_way_blocked(self, stance: np.ndarray) -> bool:
         """Would the footprint, driven straight to ``stance``, cross furniture on the map before it arrives?"""
@@ -360,6 +387,8 @@ class Grasp(_ManipulationSkill):
             ("descend", self._unless_held(self._descend)),
             ("close", self._unless_held(self._close)),
             ("check grasp", self._unless_held(self._check_grasp)),
+            ("lift off", self._unless_held(self._lift_off)),
+            ("weigh", self._unless_held(self._weigh)),
             ("lift", self._unless_held(self._lift)),
             ("verify", self._unless_held(self._verify)),
             ("carry", self._carry_taken),
@@ -486,6 +515,25 @@ class Grasp(_ManipulationSkill):
         self.target.held_by = self.params.side
         self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
 
+    def _lift_off(self) -> MotionHandle | None:
+        """A robot that balances with what it holds lifts it just off the surface first, to weigh it: lifted
+        higher with a weight the dynamics do not know, the arm sags short of its goal."""
+        side = self.params.side
+        if not self.context.robot.weighs(side):
+            return None
+        return self.context.robot.whole_body.reach(
+            side,
+            self._pose(self.grasp.position + np.array([0.0, 0.0, LIFT_OFF])),
+            speed=DESCEND_SPEED,
+            limits=self._keepout(self.surface.region),
+            tolerance=LIFT_OFF_TOLERANCE,
+        )
+
+    def _weigh(self) -> None:
+        """Off the surface: weigh it (the wrist's sensor), and balance and lift with that weight from now on."""
+        if self.context.robot.weighs(self.params.side):
+            self.target.weight = self.context.robot.weigh(self.params.side)
+
     def _lift(self) -> MotionHandle:
         # high enough that what the hand now holds passes over the things between here and the carry pose
         side = self.params.side
@@ -513,12 +561,15 @@ class Grasp(_ManipulationSkill):
             self.target.held_by = None
             self.target.confidence = 0.0  # where it went is unknown until it is seen again
             raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
-        self.target.weight = self.context.robot.weigh(self.params.side)  # a legged robot balances with it
+        self._weigh()  # again, held still and clear of everything: the better reading
+        self.target.reach_short = 0.0  # reached: wherever it is put next, its stance starts afresh
 
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt
         if self.phase in ("descend", "close"):
             self.context.robot.grippers.command(self.params.side, "open")
+        if self.phase == "descend":
+            self._note_short_reach(self.target, self.grasp.position)
         if self.phase == "descend" and self.target.kind == "mug" and not self.target.yaw_known:
             # blocked on the way down: most likely a finger on the handle, which is not where it was guessed
             self.target.yaw += math.pi / 2
@@ -599,13 +650,21 @@ class Put(_ManipulationSkill):
 
     def _lower(self) -> MotionHandle:
         target = pin.SE3(self.rotation, self.release)
-        return self.context.robot.whole_body.reach(
-            self.params.side,
+        robot, side, weight = self.context.robot, self.params.side, self.held.weight or 0.0
+        touched = None
+        if robot.weighs(side):  # the wrist feels the surface take the weight (a balancing arm lags as it moves)
+
+            def touched() -> bool:  # a thing too light to feel is lowered all the way: its release is that low
+                return robot.load(side) < (1.0 - LOAD_TAKEN) * weight
+
+        return robot.whole_body.reach(
+            side,
             target,
             speed=DESCEND_SPEED / 2,
             gaze=self.release,
             limits=self._keepout(self.surface.region),
             stop_on_contact=True,
+            touched=touched,
         )
 
     def _release(self) -> MotionHandle:
@@ -614,7 +673,12 @@ class Put(_ManipulationSkill):
         x, y, _ = hand.translation
         self.held.position = np.array([x, y, self.surface.height + self.held.size[2] / 2])
         self.held.last_seen = self.context.clock()
+        self.held.reach_short = 0.0  # put down: wherever it is taken from next, its stance starts afresh
         return self.context.robot.grippers.command(self.params.side, "open")
+
+    def on_failure(self) -> None:
+        if self.phase == "lower":
+            self._note_short_reach(self.held, self.release)
 
     def _retreat(self) -> MotionHandle:
         """Straight up until the open pads clear the top of what was just put down."""

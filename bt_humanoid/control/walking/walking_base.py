@@ -24,7 +24,7 @@ import numpy as np
 
 from bt_humanoid.control.base_motion import SpeedMonitoring
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.control.walking.walker import Phase, WalkingController
+from bt_humanoid.control.walking.walker import SET_OFF_DISTANCE, Phase, WalkingController
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.standing import standing_posture
 
@@ -56,6 +56,7 @@ class WalkingBase(SpeedMonitoring):
         self.handle: MotionHandle | None = None
         self.target: np.ndarray | None = None  # a pose goal's base pose (yaw unwrapped)
         self.goal_speed = 0.0
+        self.arrival = self.config.tolerance.position  # m: the goal counts as reached this near
         self.deadline = 0.0
         self.reference: np.ndarray | None = None  # a streamed reference (track)
         self.reference_velocity = np.zeros(3)
@@ -90,13 +91,21 @@ class WalkingBase(SpeedMonitoring):
     # --- motions -------------------------------------------------------------------------------------------------
 
     def move_to(
-        self, x: float, y: float, yaw: float, max_speed: float | None = None, shortest_turn: bool = True
+        self,
+        x: float,
+        y: float,
+        yaw: float,
+        max_speed: float | None = None,
+        shortest_turn: bool = True,
+        tolerance: float | None = None,
     ) -> MotionHandle:
         if self.handle is not None:
             self.handle.fail("pre-empted by a newer goal")
         start = self.pose()
         turn = wrap(yaw - start[2]) if shortest_turn else yaw - start[2]
         self.target = np.array([x, y, self._yaw + turn])
+        # finer than the walker's set-off distance, a standing robot would never step to arrive
+        self.arrival = max(self.config.tolerance.position if tolerance is None else tolerance, SET_OFF_DISTANCE)
         self.goal_speed = self.capped(max_speed)
         self.reference = None
         distance = float(np.hypot(x - start[0], y - start[1]))
@@ -166,8 +175,7 @@ class WalkingBase(SpeedMonitoring):
         yaw_error = abs(math.degrees(remaining_turn))
         handle.feedback = f"{error:.2f} m to go, heading off by {yaw_error:.0f}°"
         # standing, and settled: the centre of mass comes to rest over the middle of the feet after the last step
-        tolerance = self.config.tolerance
-        if self.settled() and error < tolerance.position and yaw_error < tolerance.yaw_deg:
+        if self.settled() and error < self.arrival and yaw_error < self.config.tolerance.yaw_deg:
             handle.succeed(f"arrived within {error * 100:.1f} cm, {yaw_error:.1f}°")
             self.handle = None
             self.target = None
