@@ -13,6 +13,7 @@ from bt_humanoid.navigation.follower import RouteFollower
 from bt_humanoid.navigation.navigator import OBSERVED_MEMORY
 from bt_humanoid.navigation.occupancy import OccupancyGrid
 from bt_humanoid.navigation.planner import SAMPLE_SPACING, Clearance, PlanError, Route, plan_route
+from bt_humanoid.perception.depth_camera import DepthScan
 from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.skills.navigation_skills import back_up
 from bt_humanoid.testing.scenario import Scenario, build_run
@@ -373,3 +374,25 @@ def test_a_goal_blocked_only_by_what_the_camera_saw_is_waited_for():
     feedback = [e["feedback"] for e in scenario.result.events.events if e["event"] == "status"]
     assert not any("inside an obstacle" in f for f in feedback)
     assert run.navigator.planning_times[0] == 0.0, "the first plan found the goal blocked (and the robot waited)"
+
+
+def test_what_a_hand_holds_is_not_put_on_the_map_even_where_it_rises_above_the_grip(idle_run, monkeypatch):
+    """A mug gripped below its rim stands 6 cm above the grip: the camera saw its top and the map took it for an
+    obstacle beside the robot (a biped then could not reach its place stance). Something as high half a metre
+    from the hand still goes on the map."""
+    navigator = idle_run.navigator
+    hand = idle_run.robot.hand_position("right")
+    origin = hand + np.array([-0.5, 0.0, 0.5])  # a head camera, looking down past the hand
+    away = hand + np.array([0.5, 0.0, 0.0])  # as high, but half a metre beyond the hand (and the other hand)
+    above, below = np.array([0.0, 0.0, 0.06]), np.array([0.03, 0.0, -0.1])
+    points = np.array([hand + above, hand + below, away + above])
+    directions = (points - origin) / np.linalg.norm(points - origin, axis=1, keepdims=True)
+    ranges = np.linalg.norm(points - origin, axis=1)
+    scan = DepthScan(origin, directions, ranges, np.zeros(len(points), dtype=bool))
+    monkeypatch.setattr(navigator.camera, "scan", lambda: scan)
+    navigator.grid.clear_observed()
+    navigator._update_map()
+    observed = navigator.grid.observed
+    assert not observed[navigator.grid.cell(points[:2, :2])].any()  # what the hand holds
+    assert observed[navigator.grid.cell(points[2:, :2])].all()  # what stands half a metre from it
+    navigator.grid.clear_observed()

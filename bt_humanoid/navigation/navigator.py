@@ -32,6 +32,7 @@ OBSTACLE_MIN_HEIGHT = 0.06  # m: depth points lower than this are floor
 FREE_BELOW = 0.1  # m: a ray passing a cell lower than this shows nothing taller stands there
 OWN_MARGIN = 0.03  # m beyond the footprint where depth points are the robot's own bumper
 HELD_RADIUS = 0.15  # m around a hand where points below it are what it holds
+HELD_ABOVE = 0.15  # m above the grip what a hand holds may still rise (a mug or a bottle gripped below its top)
 SEEN_DEPTH = 0.3  # m an obstacle is assumed to extend behind the face the camera sees (a person, a parcel)
 OBSERVED_MEMORY = 6.0  # s an obstacle the camera saw is kept after it was last seen (out of view: it may move)
 OBSERVED_PADDING = 0.2  # m more room given to what the camera saw than to the furniture: it may move
@@ -324,9 +325,9 @@ class Navigator:
         base = self.robot.base.pose()[:2]
         hits = scan.hits
         mine = np.hypot(*(hits[:, :2] - base).T) < self.robot.config.base.footprint_radius + OWN_MARGIN
-        for side in self.robot.config.grippers:  # what a hand holds hangs below it: not an obstacle
+        for side in self.robot.config.grippers:  # what a hand holds, below it or rising above it: not an obstacle
             hand = self.robot.hand_position(side)
-            mine |= (np.hypot(*(hits[:, :2] - hand[:2]).T) < HELD_RADIUS) & (hits[:, 2] < hand[2] + 0.05)
+            mine |= (np.hypot(*(hits[:, :2] - hand[:2]).T) < HELD_RADIUS) & (hits[:, 2] < hand[2] + HELD_ABOVE)
         keep = ~mine & (hits[:, 2] > OBSTACLE_MIN_HEIGHT) & (hits[:, 2] < ROBOT_HEIGHT)
         rows, cols = self.grid.cell(hits[:, :2])
         inside = self.grid.inside(rows, cols)
