@@ -55,6 +55,7 @@ STEP_IN = 0.04  # m nearer, at least, the next stance comes after a reach fell s
 LIFT_OFF = 0.03  # m a robot that balances with what it holds lifts it to weigh it, before the lift proper
 LIFT_OFF_TOLERANCE = (0.03, 0.2)  # m, rad: off the surface is all that counts (the arm sags under a weight unknown)
 LOAD_TAKEN = 0.5  # share of a held thing's weight the wrist no longer feels when a surface bears it
+WALKING_SWAY = 0.03  # m a walking robot's raised hand bobs and sways with its steps: more room over things
 
 
 def carry_height(belief: WorldModel, held: TrackedObject | None) -> float:
@@ -151,13 +152,15 @@ class _ManipulationSkill(PhasedSkill):
         at_least: float,
         exclude: tuple[str, ...] = (),
         start_xy: np.ndarray | None = None,
+        margin: float = 0.0,
     ) -> MotionHandle | None:
         """Lift the hand straight up until a straight move to ``goal_xy`` (from ``start_xy``, default where the
-        hand is) passes over the things on ``surface``, and to ``at_least``; nothing when it is that high already."""
+        hand is) passes ``margin`` more over the things on ``surface``, and to ``at_least``; nothing when it is
+        that high already."""
         hand = self._hand_xyz(side)
         start = hand[:2] if start_xy is None else start_xy
         things = things_on(self.context.world_model, surface, exclude)
-        height = max(at_least, transit_height(start, goal_xy, things, *self._hand_extent(side)))
+        height = max(at_least, transit_height(start, goal_xy, things, *self._hand_extent(side)) + margin)
         if hand[2] >= height - 0.02:
             return None
         whole_body = self.context.robot.whole_body
@@ -266,7 +269,9 @@ class StandNear(_ManipulationSkill):
         hand = self._hand_xyz(side)
         offset = yaw_rotation(-yaw)[:2, :2] @ (hand[:2] - np.array([x, y]))  # the hand in the base's frame
         arrived = stance[:2] + yaw_rotation(stance[2])[:2, :2] @ offset
-        return self._rise_over(side, surface, arrived, hand[2], start_xy=hand[:2])
+        # a walking robot's hand bobs with its steps (a mug on the counter was knocked over)
+        sway = WALKING_SWAY if self.context.robot_config.base.floating else 0.0
+        return self._rise_over(side, surface, arrived, hand[2], start_xy=hand[:2], margin=sway)
 
     def _stance(self) -> tuple[SupportSurface, np.ndarray]:
         """The surface worked on and the base pose (x, y, yaw) to work on it from."""
