@@ -172,3 +172,26 @@ def test_walking_in_to_the_counter_the_raised_hand_passes_over_the_mug_it_will_t
     assert min(gaps) > 0.015, f"the pads passed {min(gaps) * 100:.1f} cm over the mug's top"  # 0.3 cm below, before
     assert result.success, result.cause
     assert run.truth.in_hand("coffee mug") == "right"
+
+
+def test_a_grasp_that_stops_short_to_the_side_brings_the_biped_a_step_along_the_edge():
+    """A mug 0.24 m to the right of the stance, its handle to the east: the wrist cannot turn the hand to it there
+    and the hand stops 9 mm too far right, twice; the pick's replan stands 4 cm further left (once: the second
+    miss from the same stance adds nothing) and takes it."""
+    trial = Trial("mug", "west", (2.973, -0.195), -0.018, (2.947, 0.005), (2.25, 0.045, 0.0))
+    run = prepare_trial(trial, "told", "biped_humanoid")
+    stances: list[float] = []  # the base's y each time a grasp starts
+    run.events.listeners.append(
+        lambda e: (
+            e["event"] == "status"
+            and e.get("node", "").endswith("grasp")
+            and e["new"] == "RUNNING"
+            and stances.append(run.truth.robot_pose()[1])
+        )
+    )
+    result = run.execute()
+    run.stack.close()
+    assert result.success, result.cause
+    assert len(stances) >= 3  # two attempts from the first stance, then one from the next
+    assert stances[-1] == pytest.approx(stances[0] + 0.04, abs=0.015)  # 4 cm to the left (north), not 8
+    assert _placed_within(run, "coffee mug", trial.place) and run.truth.upright("coffee mug")

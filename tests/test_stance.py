@@ -66,10 +66,18 @@ def test_after_a_short_reach_the_biped_stands_nearer_by_as_much_but_not_past_its
 
     def distance_from_edge(nearer: float, robot: str = "biped_humanoid") -> float:
         config = load_robot_config(robot).base
-        return -0.45 - working_stance(spot, TABLE, "right", config, BOUNDS, SOUTH, nearer=nearer)[1]
+        return -0.45 - working_stance(spot, TABLE, "right", config, BOUNDS, SOUTH, shift=(nearer, 0.0))[1]
 
     assert distance_from_edge(0.0) == pytest.approx(stance.standoff)
     assert distance_from_edge(0.04) == pytest.approx(stance.standoff - 0.04)
     assert distance_from_edge(1.0) == pytest.approx(stance.closest)
     # the wheeled robot has no closest stance: it stands where it stood (its base helps the arm instead)
     assert distance_from_edge(0.04, "wheeled_humanoid") == pytest.approx(distance_from_edge(0.0, "wheeled_humanoid"))
+
+
+def test_a_shift_to_the_left_moves_the_stance_along_the_edge_by_as_much():
+    base = load_robot_config("biped_humanoid").base
+    spot = np.array([2.4, -0.45 + 0.1])
+    x0, y0, _ = working_stance(spot, TABLE, "right", base, BOUNDS, SOUTH)
+    x1, y1, _ = working_stance(spot, TABLE, "right", base, BOUNDS, SOUTH, shift=(0.0, -0.04))
+    assert (x1, y1) == pytest.approx((x0 + 0.04, y0))  # facing north, its left is west: 4 cm to its right is east

@@ -35,12 +35,14 @@ def stance_for(
     hand_lateral: float = HAND_LATERAL,
     closest: float | None = None,
     nearer: float = 0.0,
+    aside: float = 0.0,
 ) -> tuple[float, float, float]:
     """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``: ``standoff`` m from
     the edge (default: the footprint ``EDGE_CLEARANCE`` clear of it), the spot at most ``max_depth`` behind it
     and ``hand_lateral`` to the working hand's side. With ``closest``, a deeper spot brings the stance nearer
     the edge by as much, down to ``closest`` m from it: the hand then reaches as far ahead of the base; and
-    ``nearer`` m more (a hand that fell short from there), still not past ``closest``.
+    ``nearer`` m more, still not past ``closest``, and ``aside`` m to its left along the edge (a hand that fell
+    short from there: ahead, and to a side).
 
     Of the edges that reach the spot, the one whose stance is nearest the robot wins.
     """
@@ -58,7 +60,7 @@ def stance_for(
         facing = np.array([math.cos(yaw), math.sin(yaw)])
         distance = float(np.clip(min(standoff, standoff - (depth - max_depth)) - nearer, nearest, standoff))
         left = np.array([-math.sin(yaw), math.cos(yaw)])
-        stance = np.array(edge) - distance * facing + lateral * left  # the spot on the working hand's side
+        stance = np.array(edge) - distance * facing + (lateral + aside) * left  # the spot on the working hand's side
         inside = np.all(stance >= bounds[0] + footprint_radius) and np.all(stance <= bounds[1] - footprint_radius)
         if inside:
             options.append((depth, stance, yaw))
@@ -84,10 +86,10 @@ def working_stance(
     base: BaseConfig,
     bounds: np.ndarray,
     robot_xy: np.ndarray,
-    nearer: float = 0.0,
+    shift: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[float, float, float]:
-    """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml), ``nearer`` m nearer the
-    edge where its ``closest`` allows."""
+    """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml), moved by ``shift`` (m
+    ahead, nearer the edge where its ``closest`` allows; m to the left)."""
     stance = base.working_stance
     return stance_for(
         spot,
@@ -100,7 +102,8 @@ def working_stance(
         max_depth=stance.reach_depth,
         hand_lateral=stance.hand_lateral,
         closest=stance.closest,
-        nearer=nearer,
+        nearer=shift[0],
+        aside=shift[1],
     )
 
 

@@ -50,8 +50,8 @@ CARRY_TOLERANCE = (0.05, 0.2)  # m, rad: the carry pose needs no precision (a ta
 IN_THE_WAY = math.radians(20)  # a hand this close to an object's line of sight (and not behind it) hides part of it
 BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its line of sight is behind it
 ASIDE = 0.18  # m a hand in the camera's way moves outwards: out of a 20° cone at the arm's usual reach
-SHORT_REACH = 0.005  # m: a descent that stopped further than this short of its goal, ahead of the base, fell short
-STEP_IN = 0.04  # m nearer, at least, the next stance comes after a reach fell short: enough for the feet to step
+SHORT_REACH = 0.005  # m: a descent that stopped further than this short of its goal (in the plane) fell short
+STEP_IN = 0.04  # m the next stance moves, at least, after a reach fell short: enough for the feet to step
 LIFT_OFF = 0.03  # m a robot that balances with what it holds lifts it to weigh it, before the lift proper
 LIFT_OFF_TOLERANCE = (0.03, 0.2)  # m, rad: off the surface is all that counts (the arm sags under a weight unknown)
 LOAD_TAKEN = 0.5  # share of a held thing's weight the wrist no longer feels when a surface bears it
@@ -124,13 +124,16 @@ class _ManipulationSkill(PhasedSkill):
         return PAD_HALF_HEIGHT, hand_radius(None, self._is_open(side))
 
     def _note_short_reach(self, thing: TrackedObject, goal: np.ndarray) -> None:
-        """A hand that stopped short of ``goal``, ahead of the base, on its way down to take or put ``thing``
-        asks the next stance for it to come nearer (``StandNear``, where the robot's ``working_stance.closest``
-        allows): reaching further, a balancing robot would lean until it fell."""
-        _, _, yaw = self.context.robot.base.pose()
-        ahead = float((goal - self._hand_xyz(self.params.side))[:2] @ np.array([math.cos(yaw), math.sin(yaw)]))
-        if ahead > SHORT_REACH:
-            thing.reach_short += max(ahead + SHORT_REACH, STEP_IN)
+        """A hand that stopped short of ``goal`` on its way down to take or put ``thing`` asks the next stance
+        for it to move as much that way (``StandNear``; nearer the edge only where the robot's
+        ``working_stance.closest`` allows): reaching further, a balancing robot would lean until it fell."""
+        x, y, yaw = self.context.robot.base.pose()
+        miss = yaw_rotation(-yaw)[:2, :2] @ (goal - self._hand_xyz(self.params.side))[:2]  # (ahead, left)
+        length = float(np.linalg.norm(miss))
+        again = thing.short_from is not None and math.dist(thing.short_from, (x, y)) < STEP_IN / 2  # a retry
+        if length > SHORT_REACH and not again:
+            thing.reach_short = thing.reach_short + miss * max(length + SHORT_REACH, STEP_IN) / length
+            thing.short_from = np.array([x, y])
 
     def _hand_xyz(self, side: str) -> np.ndarray:
         whole_body = self.context.robot.whole_body
@@ -288,7 +291,7 @@ class StandNear(_ManipulationSkill):
             spot = np.array(p.at) if p.at is not None else surface.region.mean(axis=0)
         config = self.context.robot_config
         worked_on = self._worked_on()
-        nearer = worked_on.reach_short if worked_on is not None else 0.0
+        shift = worked_on.reach_short if worked_on is not None else np.zeros(2)
         try:
             pose = working_stance(
                 spot,
@@ -297,7 +300,7 @@ class StandNear(_ManipulationSkill):
                 config.base,
                 np.array(self.context.world.bounds),
                 self.context.robot.base.pose()[:2],
-                nearer=nearer,
+                shift=(float(shift[0]), float(shift[1])),
             )
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
@@ -342,7 +345,7 @@ class StandNear(_ManipulationSkill):
             return self.context.navigator.go_to(np.array([x, y, yaw]), p.max_speed)
         # after a reach fell short, stepping in by a few centimetres is the point: arrive that precisely
         worked_on = self._worked_on()
-        stepping_in = worked_on is not None and worked_on.reach_short > 0
+        stepping_in = worked_on is not None and bool(np.any(worked_on.reach_short))
         tolerance = STEP_IN / 2 if stepping_in else None
         return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed, tolerance=tolerance)
 
@@ -567,7 +570,8 @@ class Grasp(_ManipulationSkill):
             self.target.confidence = 0.0  # where it went is unknown until it is seen again
             raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
         self._weigh()  # again, held still and clear of everything: the better reading
-        self.target.reach_short = 0.0  # reached: wherever it is put next, its stance starts afresh
+        # reached: wherever it is put next, its stance starts afresh
+        self.target.reach_short, self.target.short_from = np.zeros(2), None
 
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt
@@ -678,7 +682,8 @@ class Put(_ManipulationSkill):
         x, y, _ = hand.translation
         self.held.position = np.array([x, y, self.surface.height + self.held.size[2] / 2])
         self.held.last_seen = self.context.clock()
-        self.held.reach_short = 0.0  # put down: wherever it is taken from next, its stance starts afresh
+        # put down: wherever it is taken from next, its stance starts afresh
+        self.held.reach_short, self.held.short_from = np.zeros(2), None
         return self.context.robot.grippers.command(self.params.side, "open")
 
     def on_failure(self) -> None:
