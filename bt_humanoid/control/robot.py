@@ -116,14 +116,14 @@ class RobotController:
     def load(self, side: str) -> float | None:
         """What the ``side`` hand's wrist sensor reads it holds now (kg), without balancing with it; None
         where ``weighs`` is false."""
-        return self.scale.weigh(side) if self.scale is not None and side in self.scale.sensors else None
+        return self.scale.weigh(side) if self.scale is not None and self.weighs(side) else None
 
     def weigh(self, side: str) -> float | None:
         """Weigh what the ``side`` hand holds (kg) and, on legs, balance with it from now until it lets go; None
         for a robot without a wrist sensor on that hand, or with no balance to tell (a wheeled base)."""
-        if self.scale is None or side not in self.scale.sensors:
+        mass = self.load(side)
+        if mass is None or self.scale is None:
             return None
-        mass = self.scale.weigh(side)
         self.scale.carry(side, mass)
         return mass
 
