@@ -14,6 +14,7 @@ from bt_humanoid.benchmarks.manipulation import Trial, prepare_trial
 from bt_humanoid.control.grasping import PAD_HALF_HEIGHT
 from bt_humanoid.control.stance import working_stance
 from bt_humanoid.control.wbc.dynamics import RobotDynamics
+from bt_humanoid.skills.manipulation_skills import STEP_IN, StandNear
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 from bt_humanoid.testing.told import tell_object_poses
@@ -195,3 +196,40 @@ def test_a_grasp_that_stops_short_to_the_side_brings_the_biped_a_step_along_the_
     assert len(stances) >= 3  # two attempts from the first stance, then one from the next
     assert stances[-1] == pytest.approx(stances[0] + 0.04, abs=0.015)  # 4 cm to the left (north), not 8
     assert _placed_within(run, "coffee mug", trial.place) and run.truth.upright("coffee mug")
+
+
+def test_after_a_short_reach_the_next_stance_is_a_step_from_where_the_robot_stood_not_from_the_last_stance():
+    """In a camera run the biped stopped 1.1 cm to one side of its stance and its hand fell short that way: a step
+    of 4 cm measured from the stance lay 2.9 cm from the robot, too little for the walker to set off, and the
+    retry failed the same. The next stance is now a step from where the robot stood; one asked for far from the
+    stance (the object has moved since) is not followed."""
+    spot = (2.961, 0.249)
+
+    def stand_near(start: tuple[float, float, float]):
+        run = build_run(
+            {"world": "apartment", "robot": "biped_humanoid", "mission": "stance", "tree": {"wait": {"seconds": 1}}},
+            robot_start=start,
+        )
+        place_object(run, "red cube", *spot, 0.0)
+        tell_object_poses(run.context.world_model, run.sim)
+        skill = StandNear("stand near", {}, run.context, "test")
+        skill.params = StandNear.Params(object="red cube")
+        return run, skill
+
+    run, skill = stand_near((2.25, 0.489, 0.0))
+    _, nominal = skill._stance()
+    run.stack.close()
+    aside = np.array([-math.sin(nominal[2]), math.cos(nominal[2])])  # the stance's left
+    start = nominal[:2] + 0.011 * aside
+    run, skill = stand_near((*start, math.degrees(nominal[2])))
+    cube = run.context.world_model.object("red cube")
+    hand = skill._hand_xyz("right")
+    skill._note_short_reach(cube, hand + np.array([*(0.009 * aside), 0.0]))  # the hand stopped 9 mm short, left
+    stood = run.robot.base.pose()[:2]
+    assert cube.step_to == pytest.approx(stood + STEP_IN * aside, abs=1e-6)  # at least a step, from here
+    _, stance = skill._stance()
+    assert np.dot(stance[:2] - stood, aside) == pytest.approx(STEP_IN, abs=1e-3)  # not 2.9 cm: the walker steps
+    cube.step_to = stood + 0.5 * aside  # asked for before the cube moved half a metre
+    _, stance = skill._stance()
+    assert stance == pytest.approx(nominal, abs=1e-6)
+    run.stack.close()

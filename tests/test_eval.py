@@ -135,35 +135,39 @@ def test_bt_eval_exits_2_with_one_line_for_bad_input(tmp_path, capsys):
     assert "--workers 0" in capsys.readouterr().err
 
 
-def test_summary_counts_what_the_episodes_report():
-    def episode(i: int, success: bool, fault: str | None, contacts: int = 0, moving: bool = False) -> dict:
-        return {
-            "episode": i,
-            "task": "bring me the {object}",
-            "command": "bring me the red cube",
-            "object": "red cube",
-            "fault": fault,
-            "success": success,
-            "failure": None if success else "safety stop: collision",
-            "sim_time": 60.0,
-            "wall_s": 10.0,
-            "person_contacts": contacts,
-            "collision": not success,
-            "ended_moving": moving,
-            "moving_after_brake": False,
-            "plan_ms": [30.0],
-            "stop_latency_s": 0.4 if fault == "new_command" else None,
-            "look_ms_median": 25.0,
-            "qp_ms_median": 0.4,
-            "qp_ms_p95": 0.6,
-        }
+def episode(i: int, success: bool, fault: str | None, contacts: int = 0, moving: bool = False, fell=False) -> dict:
+    """An episode's record as ``run_episode`` returns it."""
+    return {
+        "episode": i,
+        "task": "bring me the {object}",
+        "command": "bring me the red cube",
+        "object": "red cube",
+        "fault": fault,
+        "success": success,
+        "failure": None if success else "safety stop: collision",
+        "sim_time": 60.0,
+        "wall_s": 10.0,
+        "person_contacts": contacts,
+        "fell": fell,
+        "collision": not success,
+        "ended_moving": moving,
+        "moving_after_brake": False,
+        "plan_ms": [30.0],
+        "stop_latency_s": 0.4 if fault == "new_command" else None,
+        "look_ms_median": 25.0,
+        "qp_ms_median": 0.4,
+        "qp_ms_p95": 0.6,
+    }
 
+
+def test_summary_counts_what_the_episodes_report():
     episodes = [
         episode(0, True, None),
-        episode(1, False, "push", contacts=3),
+        episode(1, False, "push", contacts=3, fell=True),
         episode(2, True, "new_command", moving=True),
     ]
     figures = summarize(episodes, wall_s=20.0, workers=2)
+    assert figures["episodes_with_fall"] == 1
     assert figures["success"]["successes"] == 2 and figures["success"]["episodes"] == 3
     assert figures["by_fault"]["push"]["rate"] == 0.0
     assert figures["episodes_with_person_contact"] == 1
@@ -172,6 +176,64 @@ def test_summary_counts_what_the_episodes_report():
     assert figures["stop_latency_s"]["count"] == 1
     assert figures["real_time_factor_per_core"] == pytest.approx(6.0)
     assert [f["episode"] for f in figures["failures"]] == [1]
+
+
+def save_run(path: Path, episodes: list[dict], **run) -> Path:
+    """A run saved as ``bt-eval --json`` saves it (suite fetch, seed 0, the biped, commit abc1234 unless given)."""
+    saved = {"suite": "fetch", "file": "missions/benchmarks/fetch.yaml", "seed": 0, "robot": "biped_humanoid"}
+    saved |= {"commit": "abc1234", "command": f"bt-eval fetch --first {episodes[0]['episode']}", **run}
+    path.write_text(json.dumps({**saved, **summarize(episodes, wall_s=20.0, workers=2), "episodes": episodes}))
+    return path
+
+
+def test_first_runs_the_episodes_from_that_index(tmp_path, monkeypatch):
+    ran: list[int] = []
+
+    def run(file, indices, seed, args, console):  # the episodes' records, without running them
+        ran.extend(indices)
+        return [episode(i, True, None) for i in indices], 1.0
+
+    monkeypatch.setattr("bt_humanoid.evaluation.command._run", run)
+    out = tmp_path / "part.json"
+    assert eval_main(["smoke", "--first", "5", "--episodes", "3", "--json", str(out)]) == 0
+    assert ran == [5, 6, 7]
+    assert [e["episode"] for e in json.loads(out.read_text())["episodes"]] == [5, 6, 7]
+    assert eval_main(["smoke", "--first", "-1"]) == 2
+
+
+def test_merge_joins_parts_of_one_run_into_its_figures(tmp_path, capsys):
+    first = save_run(tmp_path / "a.json", [episode(0, True, None), episode(1, False, "push", fell=True)])
+    second = save_run(tmp_path / "b.json", [episode(2, True, None)])
+    out = tmp_path / "all.json"
+    assert eval_main([str(second), "--merge", str(first), "--json", str(out)]) == 0
+    joined = json.loads(out.read_text())
+    assert [e["episode"] for e in joined["episodes"]] == [0, 1, 2]
+    assert joined["success"]["successes"] == 2 and joined["success"]["episodes"] == 3
+    assert joined["episodes_with_fall"] == 1 and joined["wall_s"] == 40.0
+    assert joined["commit"] == "abc1234" and joined["command"].splitlines() == [
+        "bt-eval fetch --first 2",
+        "bt-eval fetch --first 0",
+    ]
+    assert "joined 3 episodes of 2 runs" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("other", "says"),
+    [
+        ({"seed": 1}, "seed 1"),
+        ({"robot": "wheeled_humanoid"}, "robot 'wheeled_humanoid'"),
+        ({"commit": "abc1234 + uncommitted changes"}, "is not known"),
+        ({"first": 1}, "episode 1 is in"),
+    ],
+)
+def test_merge_refuses_parts_of_other_runs_in_one_line(tmp_path, capsys, other, says):
+    first = save_run(tmp_path / "a.json", [episode(0, True, None), episode(1, True, None)])
+    index = other.pop("first", 2)
+    second = save_run(tmp_path / "b.json", [episode(index, True, None)], **other)
+    assert eval_main([str(first), "--merge", str(second), "--json", str(tmp_path / "all.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and says in err and "b.json" in err
+    assert not (tmp_path / "all.json").exists()
 
 
 @pytest.mark.slow
@@ -235,3 +297,27 @@ def test_spots_are_drawn_where_the_robot_s_own_hand_reaches():
     # the wheeled robot's reach is deeper: some of its spots are out of the biped's
     wheeled = [reachable_spot(*args, rng) for _ in range(30)]
     assert max(min(x - x0, x1 - x, y - y0, y1 - y) for x, y in wheeled) > deepest - REACH_SLACK
+
+
+@pytest.mark.sim
+def test_a_biped_knocked_over_is_counted_fallen_and_one_standing_is_not():
+    from bt_humanoid.evaluation.episode import watch_balance
+    from bt_humanoid.testing.scenario import build_run
+
+    run = build_run({"world": "apartment", "robot": "biped_humanoid", "mission": "stand", "tree": {"wait": {"seconds": 9}}})
+    fallen = watch_balance(run, run.stack)
+
+    def advance(seconds: float) -> None:
+        end = run.sim.time + seconds
+        while run.sim.time < end:
+            run.executor.advance()
+
+    advance(1.0)
+    assert fallen == []
+    pelvis = run.sim.model.body(run.sim.robot_root).id
+    run.sim.data.xfrc_applied[pelvis, :3] = (0.0, 600.0, 0.0)  # a shove far beyond what a step recovers
+    advance(0.3)
+    run.sim.data.xfrc_applied[pelvis, :3] = 0.0
+    advance(2.5)
+    run.stack.close()
+    assert fallen and fallen[0] > 1.0

@@ -27,7 +27,21 @@ def _parser() -> _Parser:
     parser.add_argument(
         "--markdown", action="store_true", help="SUITE is a saved JSON run: print its README section, run nothing"
     )
-    parser.add_argument("--episodes", type=int, help="how many episodes (default: the suite's)")
+    parser.add_argument(
+        "--merge",
+        nargs="+",
+        type=Path,
+        metavar="JSON",
+        help="SUITE is a saved JSON run: join these saved runs of other episodes to it (same suite, seed, robot "
+        "and commit), print the figures and save them (--json); run nothing",
+    )
+    parser.add_argument("--episodes", type=int, help="how many episodes, from --first (default: the suite's)")
+    parser.add_argument(
+        "--first",
+        type=int,
+        default=0,
+        help="the first episode's index (default 0): a long run split in parts, joined with --merge",
+    )
     parser.add_argument("--seed", type=int, help="draws every scene (default: the suite's)")
     parser.add_argument(
         "--scene",
@@ -60,6 +74,8 @@ def eval_main(argv: list[str] | None = None) -> int:
     console = Console(highlight=False, soft_wrap=True)
     if args.markdown:
         return _print_markdown(Path(args.suite))
+    if args.merge:
+        return _merge([Path(args.suite), *args.merge], args.json, console)
     try:
         if args.workers < 1:
             raise UserError(f"--workers {args.workers}: give 1 or more")
@@ -67,12 +83,16 @@ def eval_main(argv: list[str] | None = None) -> int:
             raise UserError(f"--episodes {args.episodes}: give 1 or more")
         if args.seed is not None and args.seed < 0:
             raise UserError(f"--seed {args.seed}: give 0 or more")
+        if args.first < 0:
+            raise UserError(f"--first {args.first}: give 0 or more")
         file = _suite_file(args.suite)
         suite, _ = load_suite(file, args.scene, args.robot)
         if args.scene is not None:
             args.scene = suite.scene  # a file's path made absolute: the workers may start elsewhere
-        episodes = min(args.episodes or suite.episodes, len(suite.instructions) or 10**9)
-        indices = list(range(episodes))
+        last = min(args.first + (args.episodes or suite.episodes), len(suite.instructions) or 10**9)
+        indices = list(range(args.first, last))
+        if not indices:
+            raise UserError(f"--first {args.first}: the suite has {len(suite.instructions)} instructions")
         if args.family is not None:
             if not suite.instructions:
                 raise UserError("--family is for suites of instructions (household)")
@@ -82,29 +102,89 @@ def eval_main(argv: list[str] | None = None) -> int:
                 raise UserError(f"--family {args.family}: no such instructions", hint=f"one of {', '.join(known)}")
         seed = suite.seed if args.seed is None else args.seed
         console.print(
-            f"bt-eval [bold]{suite.suite}[/]: {len(indices)} episodes, seed {seed}, "
+            f"bt-eval [bold]{suite.suite}[/]: {len(indices)} episodes"
+            f"{f' ({indices[0]}–{indices[-1]})' if args.first else ''}, seed {seed}, "
             f"{args.workers if args.backend == 'local' else 'ray'} worker(s) — {suite.description}"
         )
         commit = source_commit()  # before the run: the code the episodes ran, whatever is edited meanwhile
         records, wall = _run(str(file.resolve()), indices, seed, args, console)
     except UserError as error:
         return _fail_invalid(error)
-    records.sort(key=lambda r: r["episode"])
-    figures = summarize(records, wall, args.workers)
     command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
-    figures = {
-        "suite": suite.suite,
-        "file": display_path(file),
-        "seed": seed,
-        "command": command,
-        "commit": commit,
-        **figures,
-    }
+    run = {"suite": suite.suite, "file": display_path(file), "seed": seed, "robot": suite.robot, "commit": commit}
+    return _report({**run, "command": command}, records, wall, args.workers, args.json, console)
+
+
+def _report(
+    run: dict[str, Any],
+    records: list[dict[str, Any]],
+    wall: float,
+    workers: int,
+    out: Path | None,
+    console: Console,
+) -> int:
+    """Print the figures of ``records`` (what ``run`` names: suite, file, seed, robot, commit, command) and save
+    them with the episodes."""
+    records.sort(key=lambda r: r["episode"])
+    figures = {**run, **summarize(records, wall, workers)}
     _print(console, figures)
-    out = args.json or Path(f"bt-eval-{suite.suite}.json")
+    out = out or Path(f"bt-eval-{run['suite']}.json")
     out.write_text(json.dumps({**figures, "episodes": records}, indent=1) + "\n")
     console.print(f"wrote {out}")
     return EXIT_OK
+
+
+SAME_RUN = ("suite", "seed", "robot", "commit")  # what saved parts must share to be one run
+
+
+def _merge(parts: list[Path], out: Path | None, console: Console) -> int:
+    """Join saved runs of one suite's episodes, run apart (``--first``), into one."""
+    try:
+        saved = [(part, _load_saved(part)) for part in parts]
+        first = saved[0][1]
+        for part, run in saved:
+            if not run.get("commit") or "uncommitted" in run["commit"]:
+                raise UserError(
+                    f"commit {run.get('commit')!r}: the code it ran is not known",
+                    where=display_path(part),
+                    hint="join runs made from a clean checkout of one commit",
+                )
+            for key in SAME_RUN:
+                if run.get(key) != first.get(key):
+                    raise UserError(
+                        f"{key} {run.get(key)!r}, where {display_path(parts[0])} has {first.get(key)!r}",
+                        where=display_path(part),
+                        hint=f"join parts of one run: the same {', '.join(SAME_RUN)}",
+                    )
+        seen: dict[int, Path] = {}
+        for part, run in saved:
+            for record in run["episodes"]:
+                if record["episode"] in seen:
+                    raise UserError(
+                        f"episode {record['episode']} is in {display_path(seen[record['episode']])} too",
+                        where=display_path(part),
+                        hint="join parts of other episodes (--first)",
+                    )
+                seen[record["episode"]] = part
+    except UserError as error:
+        return _fail_invalid(error)
+    run = {key: first.get(key) for key in ("suite", "file", "seed", "robot", "commit")}
+    run["command"] = "\n".join(r["command"] for _, r in saved)
+    records = [record for _, r in saved for record in r["episodes"]]
+    wall = sum(r["wall_s"] for _, r in saved)
+    console.print(f"joined {len(records)} episodes of {len(saved)} runs of {run['suite']}")
+    return _report(run, records, wall, max(r["workers"] for _, r in saved), out, console)
+
+
+def _load_saved(path: Path) -> dict[str, Any]:
+    """A run ``bt-eval`` saved as JSON."""
+    try:
+        run = json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        raise UserError(f"not a saved bt-eval run: {error}", where=display_path(path)) from None
+    if not isinstance(run, dict) or not isinstance(run.get("episodes"), list) or "suite" not in run:
+        raise UserError("not a saved bt-eval run: no suite and episodes in it", where=display_path(path))
+    return run
 
 
 RUN_INPUTS = ["bt_humanoid", "behaviors", "missions", "robots", "worlds", "pyproject.toml"]  # what a run is made of
@@ -128,9 +208,9 @@ def source_commit() -> str | None:
 
 def _print_markdown(saved: Path) -> int:
     try:
-        figures = json.loads(saved.read_text())
-    except (OSError, ValueError) as error:
-        return _fail_invalid(UserError(f"not a saved bt-eval run: {error}", where=str(saved)))
+        figures = _load_saved(saved)
+    except UserError as error:
+        return _fail_invalid(error)
     print(markdown(figures, figures.get("command", f"bt-eval {figures['file']}")), end="")
     return EXIT_OK
 
@@ -202,6 +282,7 @@ def _print(console: Console, figures: dict[str, Any]) -> None:
     lines = [
         f"time to complete (successes): median {ms(done['median'], 's')}, p95 {ms(done['p95'], 's')}",
         f"episodes with a person touched: {figures['episodes_with_person_contact']}; "
+        f"with a fall: {figures['episodes_with_fall']}; "
         f"stopped by the bumper: {figures['episodes_with_collision_stop']}; "
         f"tree finished while moving: {figures['episodes_ended_moving']}; "
         f"moving after braking: {figures['episodes_moving_after_brake']}",

@@ -19,6 +19,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from bt_humanoid.benchmarks.common import FALLEN_HEIGHT, on_a_foot
 from bt_humanoid.benchmarks.navigation import free_start
 from bt_humanoid.commanding import plan_command
 from bt_humanoid.control.motion import REST_SPEED
@@ -215,6 +216,7 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
     run = MissionRun(stack, spec)
     injector = _arm(fault, run, draw) if fault is not None else None
     touched = watch_people(run, stack)
+    fell = watch_balance(run, stack)
     result = run.execute()
     if isinstance(injector, fault_kinds.NewCommand) and injector.fired is not None:
         rest = next((e["t"] for e in reversed(result.events.events) if e["event"] in ("rest", "moving")), None)
@@ -223,9 +225,11 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
         expect = fill(injector.settings.expect, draw.slots)
         follow = _planned(command, suite, stack, figures)
         if isinstance(follow, str):
-            return episode_verdict(stack, result, figures, expect, failure=follow, injector=injector, touched=touched)
+            return episode_verdict(
+                stack, result, figures, expect, failure=follow, injector=injector, touched=touched, fell=fell
+            )
         result = MissionRun(stack, follow).execute()
-    return episode_verdict(stack, result, figures, expect, injector=injector, touched=touched)
+    return episode_verdict(stack, result, figures, expect, injector=injector, touched=touched, fell=fell)
 
 
 def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:
@@ -243,6 +247,30 @@ def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:
 
     stack.observers.append(watch)
     return touched
+
+
+def watch_balance(run: MissionRun, stack: RobotStack) -> list[float]:
+    """The simulation times at which a legged robot is down in ground truth (``benchmarks.common.has_fallen``:
+    its pelvis low, or more than its soles on the floor), filled while the run steps; a wheeled robot's stays
+    empty."""
+    fallen: list[float] = []
+    if not run.sim.robot.base.floating:
+        return fallen
+    model = run.sim.model
+    on_robot = np.isin(model.geom_bodyid, sorted(run.sim.robot_bodies))  # per geom
+    footing = np.array([on_a_foot(model.geom(g).name) for g in range(model.ngeom)])
+    floor = np.array([model.geom(g).name == "floor" for g in range(model.ngeom)])
+    down = on_robot & ~footing  # a robot geom that is not a sole, on the floor: the robot is down
+
+    def watch() -> None:
+        contacts = run.sim.data.contact
+        g1, g2 = contacts.geom1, contacts.geom2
+        on_floor = np.any((down[g1] & floor[g2]) | (down[g2] & floor[g1]))
+        if on_floor or run.truth.floating_base()[0][2] < FALLEN_HEIGHT:
+            fallen.append(run.sim.time)
+
+    stack.observers.append(watch)
+    return fallen
 
 
 def _mission(suite: Suite, suite_file: str, task: Task, draw: Draw, stack: RobotStack, figures: dict):
@@ -291,6 +319,7 @@ def episode_verdict(
     failure: str | None = None,
     injector: fault_kinds.Injector | None = None,
     touched: list[float] | None = None,
+    fell: list[float] | None = None,
 ) -> dict[str, Any]:
     """Success in ground truth, and the figures the suite aggregates."""
     header = MissionHeader.model_validate({"mission": "expect", "success": expect or []})
@@ -318,6 +347,7 @@ def episode_verdict(
         "fault_fired": injector.fired.what if injector is not None and injector.fired else None,
         "sim_time": round(run.sim.time, 3),
         "person_contacts": len(touched or []),
+        "fell": bool(fell),
         "collision": bool(result is not None and result.safety and result.safety.startswith("collision")),
         "ended_moving": finish_speed >= REST_SPEED and not (result is not None and result.safety),
         "speed_at_finish": round(finish_speed, 4),

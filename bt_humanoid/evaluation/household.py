@@ -41,7 +41,8 @@ VISIT_EVERY = 25  # control steps between looks at which place the robot stands 
 
 def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool = False) -> dict[str, Any]:
     """Plan and (unless ``plan_only``) run instruction ``index``; the record bt-eval aggregates."""
-    from bt_humanoid.evaluation.episode import episode_verdict, watch_people  # episode.py dispatches here
+    # episode.py dispatches here
+    from bt_humanoid.evaluation.episode import episode_verdict, watch_balance, watch_people
 
     started = time.perf_counter()
     instruction = suite.instructions[index]
@@ -75,6 +76,7 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
             mission = {**plan.mission, "safety": {"time_budget": suite.episode_budget}}
             run = MissionRun(stack, MissionLoader.for_plans().load_data(mission, name="<command>"))
             touched = watch_people(run, stack)
+            fell = watch_balance(run, stack)
             visited: set[str] = set()
             steps = [0]
 
@@ -85,7 +87,7 @@ def run_instruction(suite: Suite, suite_file: str, index: int, plan_only: bool =
 
             stack.observers.append(watch_places)
             result = run.execute()
-            record |= episode_verdict(stack, result, figures, touched=touched)
+            record |= episode_verdict(stack, result, figures, touched=touched, fell=fell)
             missing = unmet(instruction.expect, start, truth_situation(run.truth, visited), catalogue)
             if record["success"] and missing:
                 record["success"], record["failure"] = False, "not done: " + "; ".join(missing)

@@ -70,6 +70,7 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
             "p95": _p95([e["sim_time"] for e in done]),
         },
         "episodes_with_person_contact": sum(e["person_contacts"] > 0 for e in episodes),
+        "episodes_with_fall": sum(e.get("fell", False) for e in episodes),  # runs saved before falls were watched
         "episodes_with_collision_stop": sum(e["collision"] for e in episodes),
         "episodes_ended_moving": sum(e["ended_moving"] for e in episodes),
         "episodes_moving_after_brake": sum(e["moving_after_brake"] for e in episodes),
@@ -120,6 +121,11 @@ def markdown(figures: dict[str, Any], command: str) -> str:
             continue  # a household episode's task is its family
         rows += [f"| {label}: {name} | {rate(r)} |" for name, r in sorted(figures[key].items())]
     done, latency = figures["time_to_complete_s"], figures["stop_latency_s"]
+    falls = (  # runs saved before falls were watched did not count them
+        [f"| episodes in which the robot fell (ground truth) | {figures['episodes_with_fall']} |"]
+        if "episodes_with_fall" in figures
+        else []
+    )
     lines = [
         f"Suite `{figures['suite']}` ({figures['file']}), seed {figures['seed']}, "
         f"{figures['success']['episodes']} episodes, measured at commit {figures.get('commit') or '(not recorded)'} "
@@ -135,6 +141,7 @@ def markdown(figures: dict[str, Any], command: str) -> str:
         "| --- | --- |",
         f"| time to complete, successful episodes | median {number(done['median'])} s, p95 {number(done['p95'])} s |",
         f"| episodes in which the robot touched a person | {figures['episodes_with_person_contact']} |",
+        *falls,
         f"| episodes stopped by the bumper | {figures['episodes_with_collision_stop']} |",
         "| episodes whose tree finished with the robot still moving (faster than 0.01 m/s or rad/s; "
         f"safety stops not counted) | {figures['episodes_ended_moving']} |",

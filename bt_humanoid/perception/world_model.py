@@ -35,9 +35,8 @@ class TrackedObject:
     held_by: str | None = None  # gripper side while the robot holds it
     grip_offset: float = 0.0  # m the grip site sits above the centre, while held
     weight: float | None = None  # kg, as the wrist weighed it once lifted (robots with a wrist sensor)
-    # m (ahead, to the left) the hand fell short of it from its stance: the next stance moves as much
-    reach_short: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    short_from: np.ndarray | None = None  # base (x, y) it fell short from: another miss from there counts once
+    # base (x, y) the next stance to work on it stands at: where the hand fell short of it from, moved by the miss
+    step_to: np.ndarray | None = None
     yaw_known: bool = True  # false while a mug's handle has not been seen (its yaw is a guess)
     votes: Counter = field(default_factory=Counter)  # (kind, colour, identity) → sightings, when perception tracks it
     identity: str | None = None  # which of the world's objects it is ("coke"), where its look tells them apart

@@ -52,6 +52,7 @@ BEHIND_MARGIN = 0.1  # m beyond the object's centre from which a hand on its lin
 ASIDE = 0.18  # m a hand in the camera's way moves outwards: out of a 20° cone at the arm's usual reach
 SHORT_REACH = 0.005  # m: a descent that stopped further than this short of its goal (in the plane) fell short
 STEP_IN = 0.04  # m the next stance moves, at least, after a reach fell short: enough for the feet to step
+STEP_RANGE = 0.2  # m: a step asked for further from the stance than this was for another (the object moved since)
 LIFT_OFF = 0.03  # m a robot that balances with what it holds lifts it to weigh it, before the lift proper
 LIFT_OFF_TOLERANCE = (0.03, 0.2)  # m, rad: off the surface is all that counts (the arm sags under a weight unknown)
 LOAD_TAKEN = 0.5  # share of a held thing's weight the wrist no longer feels when a surface bears it
@@ -125,15 +126,15 @@ class _ManipulationSkill(PhasedSkill):
 
     def _note_short_reach(self, thing: TrackedObject, goal: np.ndarray) -> None:
         """A hand that stopped short of ``goal`` on its way down to take or put ``thing`` asks the next stance
-        for it to move as much that way (``StandNear``; nearer the edge only where the robot's
-        ``working_stance.closest`` allows): reaching further, a balancing robot would lean until it fell."""
-        x, y, yaw = self.context.robot.base.pose()
-        miss = yaw_rotation(-yaw)[:2, :2] @ (goal - self._hand_xyz(self.params.side))[:2]  # (ahead, left)
+        to stand that much further that way from where the robot stands now (``TrackedObject.step_to``, which
+        ``StandNear`` follows nearer the edge only where the robot's ``working_stance.closest`` allows): reaching
+        further, a balancing robot would lean until it fell."""
+        miss = (goal - self._hand_xyz(self.params.side))[:2]
         length = float(np.linalg.norm(miss))
-        again = thing.short_from is not None and math.dist(thing.short_from, (x, y)) < STEP_IN / 2  # a retry
-        if length > SHORT_REACH and not again:
-            thing.reach_short = thing.reach_short + miss * max(length + SHORT_REACH, STEP_IN) / length
-            thing.short_from = np.array([x, y])
+        if length > SHORT_REACH:
+            # from here, not from the stance: a robot that stopped short of (or past) its stance would
+            # otherwise step by less than it missed, or not at all
+            thing.step_to = self.context.robot.base.pose()[:2] + miss * max(length + SHORT_REACH, STEP_IN) / length
 
     def _hand_xyz(self, side: str) -> np.ndarray:
         whole_body = self.context.robot.whole_body
@@ -291,20 +292,17 @@ class StandNear(_ManipulationSkill):
             spot = np.array(p.at) if p.at is not None else surface.region.mean(axis=0)
         config = self.context.robot_config
         worked_on = self._worked_on()
-        shift = worked_on.reach_short if worked_on is not None else np.zeros(2)
+        bounds, robot_xy = np.array(self.context.world.bounds), self.context.robot.base.pose()[:2]
         try:
-            pose = working_stance(
-                spot,
-                surface,
-                p.side,
-                config.base,
-                np.array(self.context.world.bounds),
-                self.context.robot.base.pose()[:2],
-                shift=(float(shift[0]), float(shift[1])),
-            )
+            pose = np.array(working_stance(spot, surface, p.side, config.base, bounds, robot_xy))
+            stepping = worked_on is not None and worked_on.step_to is not None  # a hand fell short: step that way
+            if stepping and math.dist(worked_on.step_to, pose[:2]) < STEP_RANGE:
+                ahead, left = yaw_rotation(-pose[2])[:2, :2] @ (worked_on.step_to - pose[:2])
+                shift = (float(ahead), float(left))
+                pose = np.array(working_stance(spot, surface, p.side, config.base, bounds, robot_xy, shift=shift))
         except StanceError as error:
             raise PhaseFailure(str(error)) from None
-        return surface, np.array(pose)
+        return surface, pose
 
     def _worked_on(self) -> TrackedObject | None:
         """The object to take (``object``), or the one the hand holds to put down (at a surface spot)."""
@@ -345,7 +343,7 @@ class StandNear(_ManipulationSkill):
             return self.context.navigator.go_to(np.array([x, y, yaw]), p.max_speed)
         # after a reach fell short, stepping in by a few centimetres is the point: arrive that precisely
         worked_on = self._worked_on()
-        stepping_in = worked_on is not None and bool(np.any(worked_on.reach_short))
+        stepping_in = worked_on is not None and worked_on.step_to is not None
         tolerance = STEP_IN / 2 if stepping_in else None
         return self.context.robot.base.move_to(x, y, yaw, max_speed=p.max_speed, tolerance=tolerance)
 
@@ -571,7 +569,7 @@ class Grasp(_ManipulationSkill):
             raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
         self._weigh()  # again, held still and clear of everything: the better reading
         # reached: wherever it is put next, its stance starts afresh
-        self.target.reach_short, self.target.short_from = np.zeros(2), None
+        self.target.step_to = None
 
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt
@@ -683,7 +681,7 @@ class Put(_ManipulationSkill):
         self.held.position = np.array([x, y, self.surface.height + self.held.size[2] / 2])
         self.held.last_seen = self.context.clock()
         # put down: wherever it is taken from next, its stance starts afresh
-        self.held.reach_short, self.held.short_from = np.zeros(2), None
+        self.held.step_to = None
         return self.context.robot.grippers.command(self.params.side, "open")
 
     def on_failure(self) -> None:
