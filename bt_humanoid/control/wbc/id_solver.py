@@ -12,7 +12,7 @@ motion M v̇ + h = Sᵀτ + Σ J_sᵀ w give them:
                −τ_max ≤ M_a v̇ + h_a − Σ J_{s,a}ᵀ w ≤ τ_max   (torque limits)
                v̇_lower ≤ v̇ ≤ v̇_upper               (joint ranges and speeds, joints held by their servos)
 
-solved with CasADi's DAQP (dense active-set, exact), built once per problem shape and reused, as ``solve_ik``.
+solved with CasADi's DAQP (dense active-set, exact), built once per problem shape and reused (``conic.py``).
 """
 
 from __future__ import annotations
@@ -20,16 +20,15 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-import casadi
 import numpy as np
 
+from bt_humanoid.control.wbc.conic import DEFAULT_SOLVER, conic
 from bt_humanoid.control.wbc.contact import SoleContact
 from bt_humanoid.control.wbc.dynamics import BASE_DOFS, RobotDynamics
 from bt_humanoid.control.wbc.id_limits.base import AccelerationBounds
 from bt_humanoid.control.wbc.id_limits.torque_limit import TorqueLimit
 from bt_humanoid.control.wbc.id_tasks.base import AccelerationTask
 
-DEFAULT_SOLVER = "daqp"
 WRENCH = 6
 ACCELERATION_WEIGHT = 1e-4  # keeps the Hessian positive definite in directions no task names
 WRENCH_WEIGHT = 1e-4  # spreads the load evenly and keeps each centre of pressure central when nothing else matters
@@ -43,43 +42,6 @@ class IdSolution:
     solved: bool
     solve_time: float  # s of wall time spent building and solving the QP
     conic_time: float  # s of it in the conic solver itself
-
-
-class _Conic:
-    """A conic solver for one problem shape, evaluated through a casadi FunctionBuffer on numpy arrays it owns.
-
-    Calling a casadi Function with numpy matrices converts them element by element (about 0.35 ms for this QP's
-    52 × 52 Hessian and 80 × 52 constraint matrix, four times DAQP's own solve); a buffer reads the arrays'
-    memory directly, column-major.
-    """
-
-    def __init__(self, solver: str, n: int, m: int) -> None:
-        pattern = {"h": casadi.Sparsity.dense(n, n), "a": casadi.Sparsity.dense(m, n)}
-        # an infeasible problem is reported through stats()["success"], not raised
-        self.function = casadi.conic("wbc_id", solver, pattern, {"error_on_fail": False})
-        self.buffer, self._evaluate = self.function.buffer()
-        self.inputs = {name: np.zeros(self.function.nnz_in(name)) for name in casadi.conic_in()}
-        self.outputs = {name: np.zeros(self.function.nnz_out(name)) for name in casadi.conic_out()}
-        for i, name in enumerate(casadi.conic_in()):
-            self.buffer.set_arg(i, memoryview(self.inputs[name]))
-        for i, name in enumerate(casadi.conic_out()):
-            self.buffer.set_res(i, memoryview(self.outputs[name]))
-        self.hessian = self.inputs["h"].reshape(n, n)  # symmetric: row- and column-major alike
-        self.constraints_t = self.inputs["a"].reshape(n, m)  # Aᵀ in row-major order is A in column-major order
-
-    def solve(self) -> bool:
-        self._evaluate()
-        return bool(self.buffer.stats()["success"])
-
-
-_solvers: dict[tuple[str, int, int], _Conic] = {}
-
-
-def _conic(solver: str, n: int, m: int) -> _Conic:
-    key = (solver, n, m)
-    if key not in _solvers:
-        _solvers[key] = _Conic(solver, n, m)
-    return _solvers[key]
 
 
 def solve_id(
@@ -158,7 +120,7 @@ def solve_id(
         else:
             lbx[start : start + WRENCH], ubx[start : start + WRENCH] = 0.0, 0.0
 
-    qp = _conic(solver, n, len(lba))
+    qp = conic(solver, n, len(lba))
     qp.hessian[:] = hessian
     qp.constraints_t[:] = A.T
     for name, value in (("g", gradient), ("lba", lba), ("uba", uba), ("lbx", lbx), ("ubx", ubx)):

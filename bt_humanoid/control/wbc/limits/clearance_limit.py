@@ -23,7 +23,8 @@ class ClearanceLimit(Limit):
 
     def covers(self, xy: np.ndarray) -> bool:
         """Whether the limit holds at ``xy`` (world x, y)."""
-        return bool(np.all(xy[:2] >= self.region[0]) and np.all(xy[:2] <= self.region[1]))
+        (x0, y0), (x1, y1) = self.region
+        return bool(x0 <= xy[0] <= x1 and y0 <= xy[1] <= y1)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         position = kinematics.pose(self.frame).translation

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
@@ -22,16 +24,14 @@ class TorsoMarginLimit(Limit):
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         torso = kinematics.pose(self.torso).translation
-        torso_jac = kinematics.jacobian(self.torso)[:3]
+        torso_jac = kinematics.jacobian(self.torso)[:2]
         rows, lower = [], []
         for frame, margin in self.margins.items():
-            offset = kinematics.pose(frame).translation - torso
-            offset[2] = 0.0
-            distance = float(np.linalg.norm(offset))
+            offset = kinematics.pose(frame).translation[:2] - torso[:2]  # horizontal
+            distance = math.hypot(offset[0], offset[1])
             if distance < 1e-6:
                 continue
-            normal = offset / distance
-            rows.append(normal @ (kinematics.jacobian(frame)[:3] - torso_jac))
+            rows.append((offset / distance) @ (kinematics.jacobian(frame)[:2] - torso_jac))
             lower.append(gap_bound(self.gain, margin - distance, dt))
         if not rows:
             return Inequality.none(len(kinematics.joints))

@@ -27,10 +27,21 @@ class Task(ABC):
     @abstractmethod
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray: ...
 
+    def residual(self, kinematics: RobotKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(J, gain · e, per-row weight): the rows this task adds to the stacked least-squares problem."""
+        err = self.gain * self.error(kinematics)
+        weight = self.weight if isinstance(self.weight, np.ndarray) else np.full(len(err), float(self.weight))
+        return self.jacobian(kinematics), err, weight
+
     def objective(self, kinematics: RobotKinematics) -> tuple[np.ndarray, np.ndarray]:
         """(H, g) of this task's quadratic cost ½ Δqᵀ H Δq + gᵀ Δq."""
-        jac = self.jacobian(kinematics)
-        err = self.gain * self.error(kinematics)
-        weight = np.broadcast_to(np.asarray(self.weight, dtype=float), err.shape)
-        weighted = jac * weight[:, None]
-        return jac.T @ weighted, -weighted.T @ err
+        return stacked_objective([self.residual(kinematics)])
+
+
+def stacked_objective(residuals: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    """(H, g) of the sum of several tasks' costs, from their rows stacked into one Jacobian: two matrix products
+    for all of them rather than two each."""
+    jac = np.vstack([r[0] for r in residuals])
+    err = np.concatenate([r[1] for r in residuals])
+    weighted = jac * np.concatenate([r[2] for r in residuals])[:, None]
+    return jac.T @ weighted, -weighted.T @ err

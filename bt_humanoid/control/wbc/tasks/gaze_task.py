@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
 from bt_humanoid.control.wbc.tasks.base import Task
@@ -28,12 +29,12 @@ class GazeTask(Task):
 
     def error(self, kinematics: RobotKinematics) -> np.ndarray:
         axis, direction = self._axes(kinematics)
-        return np.cross(axis, direction)
+        return pin.skew(axis) @ direction  # axis × direction (np.cross costs ten times more on 3-vectors)
 
     def off_axis(self, kinematics: RobotKinematics) -> float:
         """Angle (rad) between the optical axis and the direction to the target: 0 centred, π behind."""
         axis, direction = self._axes(kinematics)
-        return float(np.arctan2(np.linalg.norm(np.cross(axis, direction)), axis @ direction))
+        return float(np.arctan2(np.linalg.norm(pin.skew(axis) @ direction), axis @ direction))
 
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
         axis, _ = self._axes(kinematics)
