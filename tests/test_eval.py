@@ -304,7 +304,9 @@ def test_a_biped_knocked_over_is_counted_fallen_and_one_standing_is_not():
     from bt_humanoid.evaluation.episode import watch_balance
     from bt_humanoid.testing.scenario import build_run
 
-    run = build_run({"world": "apartment", "robot": "biped_humanoid", "mission": "stand", "tree": {"wait": {"seconds": 9}}})
+    run = build_run(
+        {"world": "apartment", "robot": "biped_humanoid", "mission": "stand", "tree": {"wait": {"seconds": 9}}}
+    )
     fallen = watch_balance(run, run.stack)
 
     def advance(seconds: float) -> None:

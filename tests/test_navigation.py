@@ -12,7 +12,7 @@ from bt_humanoid.engine.composites import RoundRobin
 from bt_humanoid.navigation.follower import RouteFollower
 from bt_humanoid.navigation.navigator import OBSERVED_MEMORY
 from bt_humanoid.navigation.occupancy import OccupancyGrid
-from bt_humanoid.navigation.planner import SAMPLE_SPACING, Clearance, PlanError, Route, plan_route
+from bt_humanoid.navigation.planner import SAMPLE_SPACING, Clearance, PlanError, Route, plan_route, pose_check
 from bt_humanoid.perception.depth_camera import DepthScan
 from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.skills.navigation_skills import back_up
@@ -53,6 +53,25 @@ def test_routes_go_around_the_furniture_with_room_to_spare(idle_run, start, goal
     # the planner checks segments every 2.5 cm on a 5 cm grid: a route point between two checks may clip the
     # corner of a neighbouring cell, up to half a cell nearer an obstacle
     assert free[middle].min() >= navigator.clearance.preferred - navigator.grid.resolution / 2
+
+
+@pytest.mark.parametrize("clearance", [None, Clearance(minimum=0.5, preferred=0.3)])
+def test_the_planner_s_pose_check_agrees_with_the_clearance_each_point_needs(idle_run, clearance):
+    """OMPL's callback looks cells up in a table made per plan: it must say what ``Clearance.required`` says, at
+    any point (near the ends and away from them, at cell borders), whichever of the two margins is larger."""
+    navigator = idle_run.navigator
+    grid, clearance = navigator.grid, clearance or navigator.clearance
+    start, goal = np.array([0.5, 0.2]), np.array([7.0, 2.4])
+    rng = np.random.default_rng(0)
+    low, high = grid.origin - 0.3, grid.origin + np.array(grid.shape[::-1]) * grid.resolution + 0.3
+    points = np.concatenate([rng.uniform(low, high, (20000, 2)), rng.normal(start, 0.6, (3000, 2))])
+    points = np.concatenate([points, np.round(points / grid.resolution) * grid.resolution])  # on cell borders
+    valid_xy = pose_check(grid, start, goal, clearance)
+    checked = np.array([valid_xy(x, y) for x, y in points])
+    expected = grid.clearance_at(points) >= clearance.required(points, start, goal)
+    inside = grid.inside(*grid.cell(points))
+    assert np.array_equal(checked, expected & inside)
+    assert 0 < checked.sum() < len(points)
 
 
 def test_a_goal_inside_an_obstacle_is_refused_with_its_position(idle_run):
