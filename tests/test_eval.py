@@ -178,6 +178,13 @@ def test_summary_counts_what_the_episodes_report():
     assert [f["episode"] for f in figures["failures"]] == [1]
 
 
+def test_real_time_factor_counts_cpu_time_where_every_episode_has_it():
+    shared = [episode(0, True, None) | {"cpu_s": 5.0}, episode(1, True, None) | {"cpu_s": 7.5}]
+    assert summarize(shared, wall_s=20.0, workers=1)["real_time_factor_per_core"] == pytest.approx(120 / 12.5)
+    older = [shared[0], episode(1, True, None)]  # a part saved before CPU time was recorded: wall time for all
+    assert summarize(older, wall_s=20.0, workers=1)["real_time_factor_per_core"] == pytest.approx(6.0)
+
+
 def save_run(path: Path, episodes: list[dict], **run) -> Path:
     """A run saved as ``bt-eval --json`` saves it (suite fetch, seed 0, the biped, commit abc1234 unless given)."""
     saved = {"suite": "fetch", "file": "missions/benchmarks/fetch.yaml", "seed": 0, "robot": "biped_humanoid"}

@@ -50,7 +50,9 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
     by["fault"] = _groups(episodes, "fault", "none")
     done = [e for e in episodes if e["success"]]
     sim = sum(e["sim_time"] for e in episodes)
-    busy = sum(e["wall_s"] for e in episodes)
+    # CPU time where every episode has it (runs saved before it was recorded have wall time only)
+    timed = "cpu_s" if all("cpu_s" in e for e in episodes) else "wall_s"
+    busy = sum(e[timed] for e in episodes)
     latencies = [e["stop_latency_s"] for e in episodes if e["stop_latency_s"] is not None]
     planning = {}
     if episodes and "planned" in episodes[0]:  # household instructions: the plan judged too, per family

@@ -86,15 +86,22 @@ class RobotKinematics:
         self._v_index = np.array(v_index)
         self._frame_ids: dict[str, int] = {}
         self._jacobians: dict[str, np.ndarray] = {}  # per update(): tasks and limits ask for the same frames
+        self._placed_q: np.ndarray | None = None  # the configuration the frame placements are of
+        self._joint_jacobians = False  # whether Pinocchio's joint Jacobians are of it too (computed on demand)
 
     def index(self, joint: str) -> int:
         return self.joints.index(joint)
 
     def update(self, positions: np.ndarray) -> None:
-        """Set the controlled joints (other joints stay at their last value) and recompute kinematics."""
+        """Set the controlled joints (other joints stay at their last value) and recompute kinematics: frame
+        placements now, Jacobians when first asked for; nothing when the configuration has not changed (a
+        control step asks where the hands are several times)."""
         self._set(positions)
-        pin.computeJointJacobians(self.model, self.data, self.q)
-        pin.updateFramePlacements(self.model, self.data)
+        if self._placed_q is not None and np.array_equal(self.q, self._placed_q):
+            return
+        pin.framesForwardKinematics(self.model, self.data, self.q)
+        self._placed_q = self.q.copy()
+        self._joint_jacobians = False
         self._jacobians.clear()
 
     def _set(self, positions: np.ndarray) -> None:
@@ -104,6 +111,7 @@ class RobotKinematics:
     def mass_matrix(self, positions: np.ndarray) -> np.ndarray:
         """Joint-space inertia (n × n over the controlled joints) at ``positions`` (no Jacobians: dynamics only)."""
         self._set(positions)
+        self._placed_q = None  # crba leaves the data at these positions: update() must place frames afresh
         full = pin.crba(self.model, self.data, self.q)
         full = np.triu(full) + np.triu(full, 1).T  # Pinocchio fills the upper triangle only
         return full[np.ix_(self._v_index, self._v_index)]
@@ -118,6 +126,9 @@ class RobotKinematics:
     def jacobian(self, frame: str) -> np.ndarray:
         """6 × n Jacobian (linear; angular) of the frame origin in world-aligned axes."""
         if frame not in self._jacobians:
+            if not self._joint_jacobians:
+                pin.computeJointJacobians(self.model, self.data, self.q)
+                self._joint_jacobians = True
             full = pin.getFrameJacobian(self.model, self.data, self.frame_id(frame), pin.LOCAL_WORLD_ALIGNED)
             self._jacobians[frame] = full[:, self._v_index]
         return self._jacobians[frame]
