@@ -68,6 +68,9 @@ def _run_parser() -> argparse.ArgumentParser:
     parser.add_argument("--realtime", action="store_true", help="pace the simulation to the wall clock")
     parser.add_argument("--tick-hz", type=float, default=20.0, help="tree tick rate in simulation time")
     parser.add_argument(
+        "--ideal-sensors", action="store_true", help="exact sensors: no noise, nothing lost (robot.yaml's sensors: off)"
+    )
+    parser.add_argument(
         "--groot",
         nargs="?",
         type=int,
@@ -114,6 +117,10 @@ def run_main(argv: list[str] | None = None) -> int:
     if sum(map(bool, given)) != 1:
         parser.error("give a mission file, --command TEXT, --audio FILE.wav, --interactive or --listen (one of them)")
     console = Console(soft_wrap=True)
+    if args.ideal_sensors:
+        from bt_humanoid.sim.sensor_models import request_ideal_sensors
+
+        request_ideal_sensors()
     if args.interactive or args.listen:
         if args.groot is not None or args.rerun is not None:
             parser.error("--groot and --rerun watch one mission: give a mission file, --command or --audio")

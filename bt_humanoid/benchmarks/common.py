@@ -7,6 +7,8 @@ import json
 import os
 from pathlib import Path
 
+from bt_humanoid.sim.sensor_models import request_ideal_sensors
+
 
 def benchmark_parser(doc: str, count: str, default: int, what: str) -> argparse.ArgumentParser:
     """The options every benchmark takes: how many (``--COUNT``), ``--seed`` and ``--json``; add its own."""
@@ -14,6 +16,7 @@ def benchmark_parser(doc: str, count: str, default: int, what: str) -> argparse.
     parser.add_argument(f"--{count}", type=int, default=default, help=f"{what} (default {default})")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--json", type=Path, help="also write the figures here")
+    parser.add_argument("--ideal-sensors", action="store_true", help="exact sensors: no noise, nothing lost")
     return parser
 
 
@@ -22,6 +25,8 @@ def parse_benchmark_args(parser: argparse.ArgumentParser, argv: list[str] | None
     args = parser.parse_args(argv)
     if getattr(args, count) < 1:
         parser.error(f"--{count} must be at least 1")
+    if args.ideal_sensors:
+        request_ideal_sensors()
     pin_to_one_core()
     return args
 

@@ -30,6 +30,7 @@ import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
 from bt_humanoid.engine.stack import RobotStack
+from bt_humanoid.perception.depth_filter import cleaned_depth
 from bt_humanoid.perception.detector import detect
 from bt_humanoid.perception.rgbd_camera import RgbdCamera, RgbdFrame
 from bt_humanoid.testing.scene import place_object
@@ -69,8 +70,9 @@ def _probe() -> RobotStack:
     return stack
 
 
-def build_scene(rng: np.random.Generator):
-    """A robot stack set up as one random scene, and the colour each object on the table was painted."""
+def build_scene(rng: np.random.Generator, seed: int = 0):
+    """A robot stack set up as one random scene, and the colour each object on the table was painted; ``seed`` is
+    the stack's (its sensors' noise), apart from ``rng``'s draw of the scene."""
     probe = _probe()
     table = probe.context.world_model.surface(SURFACE)
     names = list(probe.sim.object_bodies)  # the objects of the run: the world's, or its scene's
@@ -87,7 +89,7 @@ def build_scene(rng: np.random.Generator):
     else:
         start = np.array([x1 + distance, centre[1] + along])
     yaw = math.atan2(*(centre - start)[::-1]) + rng.uniform(-0.25, 0.25)
-    run = RobotStack.load("apartment", "wheeled_humanoid", robot_start=(*start, math.degrees(yaw)))
+    run = RobotStack.load("apartment", "wheeled_humanoid", seed, robot_start=(*start, math.degrees(yaw)))
     spots: list[np.ndarray] = []
     while len(spots) < len(chosen):
         spot = np.array([rng.uniform(x0 + 0.08, x1 - 0.08), rng.uniform(y0 + 0.08, y1 - 0.08)])
@@ -188,12 +190,13 @@ def main(argv: list[str] | None = None) -> int:
     render_ms: list[float] = []
     misses: list[str] = []
     for index in range(args.scenes):
-        run, colours = build_scene(rng)
+        run, colours = build_scene(rng, seed=args.seed * 1_000_000 + index)
         camera = RgbdCamera(run.sim, "head_camera", 320, 240)
         camera.capture()  # the first frame of a renderer compiles its shaders
         t0 = time.perf_counter()
         frame = camera.capture()
         t1 = time.perf_counter()
+        frame.depth = cleaned_depth(frame.depth)  # as the robot's perceiver does
         found = detect(frame, list(run.context.world_model.surfaces.values()))
         t2 = time.perf_counter()
         render_ms.append((t1 - t0) * 1000)

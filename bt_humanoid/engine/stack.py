@@ -27,6 +27,7 @@ from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig, load_scene
 from bt_humanoid.sim.scene_objects import body_name
+from bt_humanoid.sim.sensor_models import scanner_ranges
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
 from bt_humanoid.skills.context import SkillContext
@@ -171,11 +172,14 @@ class RobotStack:
         def hands() -> list[np.ndarray]:
             return [robot.hand_position(side) for side in config.grippers]
 
+        def noise(ranges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # the robot's range model, its own stream
+            return scanner_ranges(self.sim.sensors.scanner, ranges, self.sim.sensor_rng("scanner"))
+
         def zone(name: str, distance: float) -> None:
             self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))
 
         separation = SpeedAndSeparation(
-            SafetyScanner(model, self.sim.data, base_body, config.scanner, own=self.sim.robot_bodies),
+            SafetyScanner(model, self.sim.data, base_body, config.scanner, own=self.sim.robot_bodies, noise=noise),
             config.safety,
             config.base.footprint_radius,
             config.base.limits.max_speed,

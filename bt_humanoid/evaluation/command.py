@@ -18,6 +18,7 @@ from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation.report import markdown, summarize
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.paths import missions_dir
+from bt_humanoid.sim.sensor_models import request_ideal_sensors
 from bt_humanoid.yaml_source import display_path
 
 
@@ -59,6 +60,7 @@ def _parser() -> _Parser:
     parser.add_argument("--backend", choices=["local", "ray"], default="local", help="where episodes run")
     parser.add_argument("--address", help="Ray cluster address for --backend ray (default: start a local Ray)")
     parser.add_argument("--json", type=Path, help="write figures and episodes here (default: bt-eval-SUITE.json)")
+    parser.add_argument("--ideal-sensors", action="store_true", help="exact sensors: no noise, nothing lost")
     return parser
 
 
@@ -107,11 +109,14 @@ def eval_main(argv: list[str] | None = None) -> int:
             f"{args.workers if args.backend == 'local' else 'ray'} worker(s) — {suite.description}"
         )
         commit = source_commit()  # before the run: the code the episodes ran, whatever is edited meanwhile
+        if args.ideal_sensors:
+            request_ideal_sensors()  # the workers inherit it
         records, wall = _run(str(file.resolve()), indices, seed, args, console)
     except UserError as error:
         return _fail_invalid(error)
     command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
     run = {"suite": suite.suite, "file": display_path(file), "seed": seed, "robot": suite.robot, "commit": commit}
+    run["sensors"] = "ideal" if args.ideal_sensors else "modelled"
     return _report({**run, "command": command}, records, wall, args.workers, args.json, console)
 
 
@@ -134,7 +139,7 @@ def _report(
     return EXIT_OK
 
 
-SAME_RUN = ("suite", "seed", "robot", "commit")  # what saved parts must share to be one run
+SAME_RUN = ("suite", "seed", "robot", "commit", "sensors")  # what saved parts must share to be one run
 
 
 def _merge(parts: list[Path], out: Path | None, console: Console) -> int:
@@ -168,7 +173,7 @@ def _merge(parts: list[Path], out: Path | None, console: Console) -> int:
                 seen[record["episode"]] = part
     except UserError as error:
         return _fail_invalid(error)
-    run = {key: first.get(key) for key in ("suite", "file", "seed", "robot", "commit")}
+    run = {key: first.get(key) for key in ("suite", "file", "seed", "robot", "commit", "sensors")}
     run["command"] = "\n".join(r["command"] for _, r in saved)
     records = [record for _, r in saved for record in r["episodes"]]
     wall = sum(r["wall_s"] for _, r in saved)

@@ -23,6 +23,7 @@ from bt_humanoid.navigation.occupancy import OccupancyGrid
 from bt_humanoid.navigation.planner import Clearance, PlanError, Route, plan_route
 from bt_humanoid.navigation.static_map import ROBOT_HEIGHT, static_map
 from bt_humanoid.perception.depth_camera import DepthCamera, DepthScan
+from bt_humanoid.sim.sensor_models import depth_ranges
 from bt_humanoid.sim.simulation import Simulation
 
 RESOLUTION = 0.05  # m per map cell
@@ -61,7 +62,13 @@ class Navigator:
         self.sim, self.bounds = sim, bounds
         self.remap()
         camera = next(iter(config.cameras), None)
-        self.camera = DepthCamera(sim.model, sim.data, camera, sim.robot_root) if camera else None
+        self.camera = None
+        if camera:
+
+            def noise(ranges: np.ndarray) -> np.ndarray:  # the robot's depth model, on the camera's own stream
+                return depth_ranges(sim.sensors.depth, ranges, sim.sensor_rng(f"{camera}.mapping"))
+
+            self.camera = DepthCamera(sim.model, sim.data, camera, sim.robot_root, noise=noise)
         self.camera_frame = config.frames[camera][1] if camera in config.frames else None
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
         self.last_scan = -math.inf
@@ -83,8 +90,12 @@ class Navigator:
         """Build the floor plan from the furniture where it stands now (at start, or after it was rearranged)."""
         self.grid: OccupancyGrid = static_map(self.sim.model, self.sim.data, self.bounds, RESOLUTION)
         self.grid.observed_padding = OBSERVED_PADDING
-        # a hit on a face of the furniture may fall in the cell just outside it: that is the furniture too
-        self._near_static = cv2.dilate(self.grid.static.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+        # a hit on a face of the furniture may fall in the cell just outside it, and the scanner's noise (3σ) may
+        # carry it further: that is the furniture too
+        scanner = self.sim.sensors.scanner
+        reach = 1 + (math.ceil(3 * scanner.noise / RESOLUTION) if scanner.enabled else 0)
+        square = np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)
+        self._near_static = cv2.dilate(self.grid.static.astype(np.uint8), square).astype(bool)
 
     # ------------------------------------------------------------------ goals
 

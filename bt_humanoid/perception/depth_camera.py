@@ -11,6 +11,7 @@ the camera image itself (perception).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -48,7 +49,9 @@ class DepthCamera:
         robot_root: str,
         columns: int = 48,
         rows: int = 36,
+        noise: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
+        """``noise``: exact ranges (m, inf: nothing) → what the sensor reports (the robot's depth model)."""
         self.model, self.data = model, data
         self.camera = model.camera(camera).id
         fovy = math.radians(float(model.cam_fovy[self.camera]))
@@ -68,6 +71,7 @@ class DepthCamera:
         self._geom_ids = np.zeros(len(self._rays), dtype=np.int32)
         self._distances = np.zeros(len(self._rays))
         self.dropped_until = -math.inf  # s of simulation time: the camera delivers no frames before then
+        self.noise = noise
 
     def scan(self) -> DepthScan | None:
         """Cast every ray from the camera's current pose; None while the camera is dropped out."""
@@ -78,5 +82,7 @@ class DepthCamera:
         directions = self._rays @ rotation.T
         cast_rays(self.model, self.data, origin, directions, MAX_RANGE, self._geom_ids, self._distances)
         ranges = np.where(self._geom_ids >= 0, self._distances, np.inf)
+        if self.noise is not None:
+            ranges = self.noise(ranges)
         own = (self._geom_ids >= 0) & self._robot_geoms[np.maximum(self._geom_ids, 0)]
         return DepthScan(origin, directions, ranges, own)

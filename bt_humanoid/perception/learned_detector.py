@@ -32,6 +32,7 @@ from bt_humanoid.perception.detector import (
     Region,
     circle,
     cylinder_outline,
+    region_noise,
     resting_sphere,
     segment,
     without_fragments,
@@ -119,7 +120,8 @@ class LearnedDetector:
         for region, judgement in zip(regions, judgements, strict=True):
             if judgement.label == NONE or judgement.confidence < MIN_CONFIDENCE:
                 continue
-            detection = locate(region, judgement.label, self.known[judgement.label], frame.position)
+            known = self.known[judgement.label]
+            detection = locate(region, judgement.label, known, frame.position, region_noise(frame, region))
             detection.occluded = region.occluded
             detections.append(detection)
         result = without_fragments(detections)
@@ -128,8 +130,9 @@ class LearnedDetector:
         return result
 
 
-def locate(region: Region, name: str, known: KnownObject, eye: np.ndarray) -> Detection:
-    """Where a recognised object stands and how it is turned, from its region's points and its known shape."""
+def locate(region: Region, name: str, known: KnownObject, eye: np.ndarray, noise: float = 0.0) -> Detection:
+    """Where a recognised object stands and how it is turned, from its region's points and its known shape;
+    ``noise``: σ (m) of the points' depth."""
     points, surface = region.points, region.surface
     heights = points[:, 2] - surface.height
     top = float(heights.max())
@@ -153,7 +156,7 @@ def locate(region: Region, name: str, known: KnownObject, eye: np.ndarray) -> De
             centre += across_long * math.copysign((size[1] - narrow) / 2, float(across_long @ sight))
         yaw = long_axis
     elif shape == "sphere":
-        ball = resting_sphere(points, surface.height, top)
+        ball = resting_sphere(points, surface.height, top, noise)
         centre = ball[:2] if ball is not None else circle(band)[0]
     else:
         lid = len(flat_top) >= WELL_SEEN_TOP and circle(flat_top)[1] > LID_WIDTH * size[0] * 0.8

@@ -2,7 +2,9 @@
 
 It runs at a low rate while a mission runs (a rendered frame costs about
 20 ms of wall time) and on demand when a skill needs a fresh look
-(``look()``). The robot's own body is masked out of every frame from its
+(``look()``). The camera's depth comes with its noise and holes (the robot's
+sensor models); small holes are filled (``depth_filter.py``) and the detector
+allows for the noise. The robot's own body is masked out of every frame from its
 kinematic model (a segmentation render of the robot's geoms), as a real
 robot filters itself out of its point cloud. A world whose world.yaml names a
 trained detector has its objects recognised by it (``learned_detector.py``);
@@ -18,6 +20,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
+from bt_humanoid.perception.depth_filter import cleaned_depth
 from bt_humanoid.perception.detector import Detection, detect
 from bt_humanoid.perception.fusion import integrate
 from bt_humanoid.perception.learned_detector import LearnedDetector
@@ -70,6 +73,7 @@ class Perceiver:
         frame = self.camera.capture()
         if frame is None:
             return []  # no frame: the belief keeps what it had
+        frame.depth = cleaned_depth(frame.depth)
         self._mask_robot(frame)
         belief = self.world_model()
         surfaces = list(belief.surfaces.values())

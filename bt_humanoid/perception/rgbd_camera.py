@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from bt_humanoid.sim.sensor_models import DepthModel, axial_sigma, colour_image, depth_image
 from bt_humanoid.sim.simulation import Simulation
 
 HIDDEN_DEPTH = 100.0  # m given to pixels the robot's own body covers: far beyond anything the detector considers
@@ -21,7 +22,8 @@ HIDDEN_DEPTH = 100.0  # m given to pixels the robot's own body covers: far beyon
 
 @dataclass
 class RgbdFrame:
-    """One capture: colour (H, W, 3 uint8), depth along the optical axis (H, W, m), intrinsics, pose."""
+    """One capture: colour (H, W, 3 uint8), depth along the optical axis (H, W, m; 0 where nothing returned, as a
+    depth camera's driver reports it), intrinsics, pose."""
 
     rgb: np.ndarray
     depth: np.ndarray
@@ -31,6 +33,11 @@ class RgbdFrame:
     rotation: np.ndarray  # camera axes in the world (3, 3): x right, y up, looking along -z
     time: float
     hidden: np.ndarray | None = None  # (H, W) bool: pixels where the robot's own body blocks the view
+    noise: DepthModel | None = None  # the depth's noise, as the camera's data sheet gives it (None: exact)
+
+    def depth_sigma(self, distance: float) -> float:
+        """σ (m) of a depth reading at ``distance`` m, square on (0 for an exact camera)."""
+        return float(axial_sigma(self.noise, np.array(distance))) if self.noise is not None else 0.0
 
     def hide(self, mask: np.ndarray) -> None:
         """Mark ``mask``'s pixels as covered by the robot's own body: nothing there for the detector."""
@@ -67,10 +74,11 @@ _OFF = (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION, mujo
 
 
 class RgbdCamera:
-    """Renders one MuJoCo camera at a fixed resolution."""
+    """Renders one MuJoCo camera at a fixed resolution, with the robot's sensor models (noise, missing depth)."""
 
     def __init__(self, sim: Simulation, camera: str, width: int, height: int) -> None:
         self.sim = sim
+        self.name = camera
         self.camera = sim.model.camera(camera).id
         self.width, self.height = width, height
         self._colour = mujoco.Renderer(sim.model, height, width)
@@ -87,6 +95,10 @@ class RgbdCamera:
         data = self.sim.data
         rgb = self._render(self._colour)
         depth = self._render(self._depth).astype(np.float64)
+        models = self.sim.sensors
+        # depth is lost on dark surfaces: how dark they are, not how the colour stream's noise shows them
+        depth = depth_image(models.depth, depth, rgb, self.focal, self.sim.sensor_rng(f"{self.name}.depth"))
+        rgb = colour_image(models.colour, rgb, self.sim.sensor_rng(f"{self.name}.colour"))
         return RgbdFrame(
             rgb=rgb,
             depth=depth,
@@ -95,6 +107,7 @@ class RgbdCamera:
             position=data.cam_xpos[self.camera].copy(),
             rotation=data.cam_xmat[self.camera].reshape(3, 3).copy(),
             time=self.sim.time,
+            noise=models.depth if models.depth.enabled else None,
         )
 
     def _render(self, renderer: mujoco.Renderer) -> np.ndarray:

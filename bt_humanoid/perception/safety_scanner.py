@@ -12,6 +12,7 @@ few rays, as they would a real scanner's.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -30,7 +31,9 @@ class SafetyScanner:
         base_body: int,
         config: ScannerConfig,
         own: set[int] | None = None,
+        noise: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
     ) -> None:
+        """``noise``: exact ranges (m) → reported ranges and which rays returned (the robot's range model)."""
         self.model, self.data = model, data
         self.base_body = base_body
         self._own_geom = np.isin(model.geom_bodyid, sorted(own or ()))  # geoms of the robot's own bodies
@@ -40,6 +43,7 @@ class SafetyScanner:
         self._distances = np.zeros(config.rays)
         self.period = 1.0 / config.rate_hz
         self.last_scan = -math.inf
+        self.noise = noise
 
     def scan(self) -> np.ndarray | None:
         """The hits of a fresh scan (world x, y) when one is due, else None."""
@@ -65,4 +69,8 @@ class SafetyScanner:
         )
         hit = self._geom_ids >= 0
         hit[hit] = ~self._own_geom[self._geom_ids[hit]]
-        return origin[:2] + directions[hit, :2] * self._distances[hit, None]
+        ranges = self._distances
+        if self.noise is not None:
+            ranges, returned = self.noise(ranges)
+            hit &= returned
+        return origin[:2] + directions[hit, :2] * ranges[hit, None]

@@ -8,6 +8,7 @@ from typing import Literal
 from pydantic import Field, model_validator
 
 from bt_humanoid.paths import robots_dir
+from bt_humanoid.sim.sensor_models import SensorModels
 from bt_humanoid.strict_model import StrictModel
 from bt_humanoid.yaml_source import read_config
 
@@ -272,6 +273,7 @@ class RobotConfig(StrictModel):
     postures: dict[str, dict[str, float]]
     legs: LegsConfig | None = Field(None, description="torque-controlled legs under a floating base")
     imu: ImuConfig | None = None
+    sensors: SensorModels = Field(SensorModels(), description="how far the sensors are from the truth (noise)")
     safety: SafetyDefaults = SafetyDefaults()
     recovery: RecoveryDefaults = RecoveryDefaults()
     folder: Path = Path()

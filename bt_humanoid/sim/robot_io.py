@@ -10,6 +10,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from bt_humanoid.sim.sensor_models import encoder_steps, quantise
 from bt_humanoid.sim.simulation import Simulation
 
 
@@ -26,12 +27,25 @@ class MujocoRobotIO:
         self.lower = np.array([model.jnt_range[model.joint(j).id][0] for j in joints])
         self.upper = np.array([model.jnt_range[model.joint(j).id][1] for j in joints])
         self.limited = np.array([bool(model.jnt_limited[model.joint(j).id]) for j in joints])
+        # encoders count whole steps; the base's planar joints are not encoders (localisation tells where it is)
+        rotary = np.array([model.jnt_type[model.joint(j).id] == mujoco.mjtJoint.mjJNT_HINGE for j in joints])
+        base = set(sim.robot.base.joints.values())
+        self._encoder = np.array([j not in base for j in joints], dtype=bool)
+        self._steps = encoder_steps(sim.sensors.encoders, rotary[self._encoder]) if self._encoder.any() else None
+        imu = sim.robot.imu
+        self._imu_noise = {}  # sensor name → σ per axis of its white noise
+        if imu is not None and sim.sensors.imu.enabled:
+            self._imu_noise = {imu.gyro: sim.sensors.imu.gyro, imu.accelerometer: sim.sensors.imu.accelerometer}
 
     def index(self, joint: str) -> int:
         return self._index[joint]
 
     def positions(self) -> np.ndarray:
-        return self.sim.data.qpos[self._qpos]
+        """What the encoders read: joint positions in whole counts."""
+        positions = self.sim.data.qpos[self._qpos]
+        if self._steps is not None:
+            positions[self._encoder] = quantise(positions[self._encoder], self._steps)
+        return positions
 
     def velocities(self) -> np.ndarray:
         return self.sim.data.qvel[self._qvel]
@@ -67,8 +81,12 @@ class MujocoRobotIO:
         return float(model.actuator_gainprm[actuator, 0]), float(-model.actuator_biasprm[actuator, 2]), limit
 
     def sensor(self, name: str) -> np.ndarray:
-        """A sensor's reading (the robot's IMU, foot force and touch sensors), as of the last physics step."""
-        return self.sim.data.sensor(name).data
+        """A sensor's reading (the robot's IMU, foot force and touch sensors), as of the last physics step; the IMU's
+        rates and specific force with its white noise."""
+        reading = self.sim.data.sensor(name).data
+        if name in self._imu_noise:
+            return reading + self.sim.sensor_rng(name).standard_normal(reading.shape) * self._imu_noise[name]
+        return reading
 
     def command(self, actuators: np.ndarray, values: np.ndarray) -> None:
         self.sim.data.ctrl[actuators] = values

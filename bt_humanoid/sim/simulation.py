@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import zlib
 from collections.abc import Callable
 
 # Off-screen rendering without a display needs EGL; set before mujoco loads.
@@ -22,6 +23,7 @@ from bt_humanoid.sim.holding import CARRY_POSTURE, SQUEEZE, Hold, hold_for
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig, load_scene, start_pose
 from bt_humanoid.sim.scene_objects import PlacedObject, SceneError, place_scene, surface_tops
+from bt_humanoid.sim.sensor_models import SensorModels, ideal_sensors_requested
 from bt_humanoid.sim.standing import Stance, standing_posture
 from bt_humanoid.sim.walkers import WalkerDriver
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
@@ -33,6 +35,9 @@ class Simulation:
     def __init__(self, world: WorldConfig, robot: RobotConfig, scene: SceneConfig | None = None) -> None:
         self.world = world
         self.robot = robot
+        #: what the robot's sensors add to the truth: robot.yaml's models, or none (--ideal-sensors)
+        self.sensors = SensorModels.ideal() if ideal_sensors_requested() else robot.sensors
+        self._sensor_rngs: dict[str, np.random.Generator] = {}
         if scene is None and world.scene is not None:
             scene = load_scene(world, world.scene)
         self.scene = scene
@@ -107,7 +112,15 @@ class Simulation:
                 self.data.ctrl[self.actuator_for_joint(joint)] = gripper.closed
         self.seed = seed  # the run's seed: whatever draws random numbers (route planning) starts from it
         self.rng = np.random.default_rng(seed)
+        self._sensor_rngs.clear()
         mujoco.mj_forward(self.model, self.data)
+
+    def sensor_rng(self, sensor: str) -> np.random.Generator:
+        """The named sensor's own random stream, from the run's seed: the same seed gives the same noise, and one
+        sensor's draws do not shift another's (or route planning's)."""
+        if sensor not in self._sensor_rngs:
+            self._sensor_rngs[sensor] = np.random.default_rng([self.seed, zlib.crc32(sensor.encode())])
+        return self._sensor_rngs[sensor]
 
     def _check_hold(self, held: PlacedObject) -> Hold:
         """How the hand holds the scene's object; a UserError when this robot cannot hold it so."""

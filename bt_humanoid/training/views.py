@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from bt_humanoid.perception.depth_filter import cleaned_depth
 from bt_humanoid.perception.map_knowledge import map_world_model
 from bt_humanoid.perception.perceiver import rendered_geoms
 from bt_humanoid.perception.rgbd_camera import RgbdCamera, RgbdFrame
@@ -151,6 +152,7 @@ class ViewMaker:
         """The frame as the robot sees it, and per pixel the index of the instance it shows (-1: none)."""
         frame = self.camera.capture()
         assert frame is not None
+        frame.depth = cleaned_depth(frame.depth)  # as the robot's perceiver does
         geoms = rendered_geoms(self._segmentation, self.sim.data, self.camera.camera)
         frame.hide((geoms >= 0) & self._robot_geoms[np.maximum(geoms, 0)])
         shown = np.where(geoms >= 0, self._instance_of_geom[np.maximum(geoms, 0)], -1)
