@@ -44,7 +44,8 @@ SPHERE_FIT = 0.03  # RMS distance from a fitted sphere, relative to its radius, 
 NOISE_ON_SPHERE = 0.75
 # share of a thing's points within FLAT_BAND of its top above which it has a lid, not a ball's cap: a ball's cap
 # holds 0.04-0.13 of its points, a cube's lid 0.2-0.42 (measured over the perception benchmark's scenes, with and
-# without depth noise; with noise a cube's points fit a sphere as loosely as a ball's)
+# without depth noise). It decides only when the noise makes the sphere fit loose: then a cube's points fit a
+# sphere as well as a ball's
 BALL_FLATNESS = 0.16
 RESTS = 0.15  # relative error allowed in a ball's resting pose: centre one radius above the surface, top two
 BOX_FLATNESS = 0.3  # share of a thing's visible points on its flat top above which it is a box (a lid faces up)
@@ -191,7 +192,9 @@ def _describe(
     if len(points) < HANDLE_VIEW:
         handle = None  # a few pixels of outline do not show a handle reliably
     yaw_known = True
-    ball = resting_sphere(points, surface.height, top, noise) if flatness < BALL_FLATNESS else None
+    ball = resting_sphere(points, surface.height, top)  # as tight a fit as a ball's points give without noise
+    if ball is None and noise > 0 and flatness < BALL_FLATNESS:  # as loose as the noise makes it, and no lid
+        ball = resting_sphere(points, surface.height, top, noise)
     if ball is not None:  # first: a ball half hidden looks narrow and tall
         kind = "ball"
         centre, diameter = ball[:2], 2.0 * float(ball[2])
