@@ -136,12 +136,13 @@ def estimation_errors(config: RobotConfig, seconds: float, sway: float = 0.0, pu
 @pytest.mark.sim
 def test_standing_and_swaying_the_estimate_follows_the_truth(config):
     """The robot sways its centre of mass 4 cm to each side for 6 s, on the estimate alone; the estimate stays within
-    2 mm and 1 cm/s of the truth (2 mm/s rms; measured 0.3 mm, 5 mm/s, 0.4 mm/s). The attitude is the IMU's,
-    carried over its one-step latency (the gyro's own lag remains: about 1 mrad/s here)."""
+    2 mm and 1 cm/s of the truth (2 mm/s rms; measured 0.8 mm, 6 mm/s, 0.8 mm/s with the IMU's noise). The attitude
+    is the IMU's, carried over its one-step latency; the angular velocity is the gyro's, its white noise and all
+    (0.017 rad/s at worst over 3000 readings of σ 0.004: the bound is 1 mrad/s of lag and five σ)."""
     errors = estimation_errors(config, 6.0, sway=0.04)
     assert errors["position"] < 0.002
     assert errors["velocity"] < 0.01 and errors["velocity rms"] < 0.002
-    assert errors["attitude"] < 1e-4 and errors["angular velocity"] < 0.01
+    assert errors["attitude"] < 1e-4 and errors["angular velocity"] < 0.001 + 5 * config.sensors.imu.gyro
 
 
 @pytest.mark.sim

@@ -39,6 +39,10 @@ class RgbdFrame:
         """σ (m) of a depth reading at ``distance`` m, square on (0 for an exact camera)."""
         return float(axial_sigma(self.noise, np.array(distance))) if self.noise is not None else 0.0
 
+    def depth_sigmas(self) -> np.ndarray | None:
+        """Per pixel, σ (m) of its depth reading (None for an exact camera)."""
+        return axial_sigma(self.noise, self.depth) if self.noise is not None else None
+
     def hide(self, mask: np.ndarray) -> None:
         """Mark ``mask``'s pixels as covered by the robot's own body: nothing there for the detector."""
         self.hidden = mask if self.hidden is None else self.hidden | mask
