@@ -77,3 +77,21 @@ def test_noisy_balls_are_balls_and_noisy_cubes_are_cubes():
         # one view of a ball through noise is now and then taken for a mug (its cap then looks like a lid): 3 of
         # these 80 views, 1 ball of about 60 in the perception benchmark
         assert balls.count("ball") >= (40 if sigma == 0 else 37), (sigma, balls)
+
+
+def test_noise_far_away_is_not_taken_for_depth_edges():
+    from bt_humanoid.perception.detector import DEPTH_JUMP, _depth_edges, _jump
+    from bt_humanoid.perception.rgbd_camera import RgbdFrame
+    from bt_humanoid.sim.sensor_models import DepthModel, depth_image
+
+    model = DepthModel(dropout=0.0)
+    wall = np.full((240, 320), 3.0)
+    wall[:, 200:] = 3.3  # a real edge: 30 cm further
+    grey = np.full((240, 320, 3), 128, np.uint8)
+    depth = depth_image(model, wall, grey, 207.8, np.random.default_rng(8))
+    depth[depth == 0] = 3.3  # the far side's lost pixels, filled as the perceiver's hole filling does
+    frame = RgbdFrame(grey, depth, 207.8, (160.0, 120.0), EYE, np.eye(3), 0.0, noise=model)
+    edges = _depth_edges(depth, _jump(frame))
+    assert edges[:, 5:190].mean() < 0.005  # σ 1.4 cm: a 3 cm step between neighbours is the noise's, not an edge
+    assert edges[:, 200].mean() > 0.95  # the 30 cm step is
+    assert _depth_edges(depth, np.full(depth.shape, DEPTH_JUMP))[:, 5:190].mean() > 0.05  # as it was without
