@@ -330,3 +330,15 @@ def test_a_biped_knocked_over_is_counted_fallen_and_one_standing_is_not():
     advance(2.5)
     run.stack.close()
     assert fallen and fallen[0] > 1.0
+
+
+def test_a_run_logged_to_a_file_says_each_episode_as_it_ends(tmp_path, monkeypatch, capsys):
+    def run_local(file, indices, seed, workers, scene, plan_only, robot):  # records, without running them
+        for i in indices:
+            yield episode(i, i != 1, None)
+
+    monkeypatch.setattr("bt_humanoid.evaluation.backends.run_local", run_local)
+    assert eval_main(["smoke", "--episodes", "3", "--json", str(tmp_path / "run.json")]) == 0
+    said = capsys.readouterr().out
+    assert "episode 0: succeeded (1/3 done)" in said and "episode 2: succeeded (3/3 done)" in said
+    assert "episode 1 (bring me the red cube): safety stop: collision" in said

@@ -247,6 +247,8 @@ def _run(file: str, indices: list[int], seed: int, args, console: Console) -> tu
             if "planned" in record:
                 rate = f"{sum(r['planned'] for r in records)}/{len(records)} planned right, " + rate
             progress.update(bar, advance=1, rate=rate)
+            if record["success"] and not console.is_terminal:  # a log has no live bar: a line per episode
+                progress.console.print(f"  episode {record['episode']}: succeeded ({len(records)}/{len(indices)} done)")
             if record.get("plan_failure"):
                 said = f"  episode {record['episode']} ({record['command']})"
                 progress.console.print(f"{said}: plan {record['plan_failure']}")

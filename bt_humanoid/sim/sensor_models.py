@@ -119,15 +119,17 @@ def depth_image(
     """A rendered depth image (H × W, m along the optical axis) as the camera reports it: noisy, 0 where lost."""
     if not model.enabled:
         return depth
+    depth = depth.astype(np.float32)  # millimetres matter, not the float64's digits: half the time
     angle = _viewing_angle(depth, focal)
-    noisy = depth + rng.standard_normal(depth.shape) * axial_sigma(model, depth, angle)
-    lost = rng.random(depth.shape) < model.dropout
-    lost |= (rng.random(depth.shape) < model.edge_dropout) & _far_side_of_edges(depth, model.edge_jump)
+    noisy = depth + rng.standard_normal(depth.shape, dtype=np.float32) * axial_sigma(model, depth, angle)
+    chance = rng.random((3, *depth.shape), dtype=np.float32)
+    lost = chance[0] < model.dropout
+    lost |= (chance[1] < model.edge_dropout) & _far_side_of_edges(depth, model.edge_jump)
     dark = rgb.sum(axis=2, dtype=np.uint16) < 3 * 255 * model.dark_level
-    lost |= (rng.random(depth.shape) < model.dark_dropout) & dark
+    lost |= (chance[2] < model.dark_dropout) & dark
     lost |= (angle > math.radians(model.grazing_deg)) | (depth > model.max_range)
     noisy[lost] = 0.0
-    return noisy
+    return noisy.astype(np.float64)
 
 
 def depth_ranges(model: DepthModel, ranges: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -184,7 +186,7 @@ def _viewing_angle(depth: np.ndarray, focal: float) -> np.ndarray:
     height, width = depth.shape
     u = (np.arange(width, dtype=np.float32) + 0.5 - width / 2)[None, :]
     v = (np.arange(height, dtype=np.float32) + 0.5 - height / 2)[:, None]
-    z = depth.astype(np.float32)
+    z = depth.astype(np.float32, copy=False)
     slope_u, slope_v = _gentler_difference(z, 1), _gentler_difference(z, 0)
     normal = np.sqrt((focal * slope_u) ** 2 + (focal * slope_v) ** 2 + (z + u * slope_u + v * slope_v) ** 2)
     cosine = focal * z / np.maximum(normal * np.sqrt(u**2 + v**2 + focal**2), 1e-12)
