@@ -229,6 +229,7 @@ def test_merge_joins_parts_of_one_run_into_its_figures(tmp_path, capsys):
     [
         ({"seed": 1}, "seed 1"),
         ({"robot": "wheeled_humanoid"}, "robot 'wheeled_humanoid'"),
+        ({"sensors": "ideal"}, "sensors 'ideal'"),
         ({"commit": "abc1234 + uncommitted changes"}, "is not known"),
         ({"first": 1}, "episode 1 is in"),
     ],
