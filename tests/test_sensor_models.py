@@ -166,3 +166,14 @@ def test_the_imu_reads_with_white_noise(monkeypatch):
     assert gyro.std(axis=0) == pytest.approx([sim.sensors.imu.gyro] * 3, rel=0.1)
     touch = sim.robot.legs.left.touch_sensor
     assert np.array_equal(io.sensor(touch), sim.data.sensor(touch).data)  # only the IMU's rates and force are noisy
+
+
+@pytest.mark.parametrize(
+    "block",
+    [{"depth": {"axial": [-0.001, 0.0019, 0.4]}}, {"depth": {"enabled": 1}}, {"scanner": {"dropout": 1.5}}],
+)
+def test_a_sensors_block_with_an_impossible_figure_is_refused(block):
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError):
+        SensorModels.model_validate(block)

@@ -7,7 +7,7 @@ import json
 import os
 from pathlib import Path
 
-from bt_humanoid.sim.sensor_models import request_ideal_sensors
+from bt_humanoid.sim.sensor_models import ideal_sensors_requested, request_ideal_sensors
 
 
 def benchmark_parser(doc: str, count: str, default: int, what: str) -> argparse.ArgumentParser:
@@ -46,7 +46,8 @@ def percentile(values: list[float], q: float) -> float:
 def save_figures(path: Path | None, figures: dict) -> None:
     """Write the figures as JSON when ``--json PATH`` was given."""
     if path is not None:
-        path.write_text(json.dumps(figures, indent=2) + "\n")
+        sensors = "ideal" if ideal_sensors_requested() else "modelled"  # which the figures were measured with
+        path.write_text(json.dumps({"sensors": sensors, **figures}, indent=2) + "\n")
 
 
 FALLEN_HEIGHT = 0.35  # m: a legged robot's pelvis below this has fallen

@@ -16,6 +16,7 @@ from typing import Any
 
 from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation.episode import run_episode
+from bt_humanoid.sim.sensor_models import IDEAL_SENSORS_VARIABLE, ideal_sensors_requested
 
 
 def _pin_worker(cores: list[int], counter) -> None:
@@ -74,7 +75,15 @@ def run_ray(
             "--backend ray needs Ray", hint="pip install 'bt-humanoid[ray]', or use --backend local"
         ) from None
     if not ray.is_initialized():
-        ray.init(address=address, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
+        # a cluster's workers do not inherit this process's environment: --ideal-sensors goes with the tasks
+        sensors = {"env_vars": {IDEAL_SENSORS_VARIABLE: "1"}} if ideal_sensors_requested() else None
+        ray.init(
+            address=address,
+            include_dashboard=False,
+            log_to_driver=False,
+            ignore_reinit_error=True,
+            runtime_env=sensors,
+        )
     remote = ray.remote(num_cpus=1)(run_episode)
     pending = [remote.remote(suite_file, index, seed, None, scene, plan_only, robot) for index in indices]
     while pending:

@@ -18,7 +18,7 @@ from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation.report import markdown, summarize
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.paths import missions_dir
-from bt_humanoid.sim.sensor_models import request_ideal_sensors
+from bt_humanoid.sim.sensor_models import ideal_sensors_requested, request_ideal_sensors
 from bt_humanoid.yaml_source import display_path
 
 
@@ -116,7 +116,7 @@ def eval_main(argv: list[str] | None = None) -> int:
         return _fail_invalid(error)
     command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
     run = {"suite": suite.suite, "file": display_path(file), "seed": seed, "robot": suite.robot, "commit": commit}
-    run["sensors"] = "ideal" if args.ideal_sensors else "modelled"
+    run["sensors"] = "ideal" if ideal_sensors_requested() else "modelled"  # the flag, or BT_IDEAL_SENSORS=1
     return _report({**run, "command": command}, records, wall, args.workers, args.json, console)
 
 

@@ -14,7 +14,7 @@ import math
 import os
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, NonNegativeFloat, StrictBool
 
 from bt_humanoid.strict_model import StrictModel
 
@@ -28,8 +28,10 @@ class DepthModel(StrictModel):
     pattern does not come back: beside a depth edge (the far side lies in the projector's shadow), on dark
     surfaces that absorb it, at grazing angles, and now and then anywhere."""
 
-    enabled: bool = True
-    axial: tuple[float, float, float] = Field((0.0012, 0.0019, 0.4), description="a (m), b (1/m), c (m) of σ(z)")
+    enabled: StrictBool = True
+    axial: tuple[NonNegativeFloat, NonNegativeFloat, NonNegativeFloat] = Field(
+        (0.0012, 0.0019, 0.4), description="a (m), b (1/m), c (m) of σ(z)"
+    )
     grazing_noise: float = Field(0.0001, ge=0, description="d (m^1.5) of σ's grazing-angle term")
     edge_jump: float = Field(0.05, gt=0, description="m between neighbouring pixels that makes a depth edge")
     edge_dropout: float = Field(0.5, ge=0, le=1, description="chance a pixel on the far side of an edge is lost")
@@ -43,7 +45,7 @@ class DepthModel(StrictModel):
 class ColourModel(StrictModel):
     """The colour stream: per-pixel sensor noise and an auto-exposure that never settles exactly."""
 
-    enabled: bool = True
+    enabled: StrictBool = True
     noise: float = Field(2.0, ge=0, description="σ of the per-pixel noise, in 8-bit levels")
     exposure: float = Field(0.05, ge=0, description="σ of the frame's log brightness gain (5 %: auto-exposure)")
 
@@ -52,7 +54,7 @@ class RangeModel(StrictModel):
     """A time-of-flight range finder (the base's safety scanner): range noise and lost returns. σ 1.5 cm is of
     the order of a safety laser scanner's data sheet (statistical error of a few centimetres at most)."""
 
-    enabled: bool = True
+    enabled: StrictBool = True
     noise: float = Field(0.015, ge=0, description="σ of a range, m")
     dropout: float = Field(0.01, ge=0, le=1, description="chance a ray returns nothing")
 
@@ -60,7 +62,7 @@ class RangeModel(StrictModel):
 class EncoderModel(StrictModel):
     """Joint encoders: positions come in counts (a 16-bit absolute encoder on the joint's output)."""
 
-    enabled: bool = True
+    enabled: StrictBool = True
     bits: int = Field(16, ge=8, le=24, description="counts per turn of a rotary joint: 2^bits")
     linear_resolution: float = Field(1e-5, gt=0, description="m per count of a sliding joint")
 
@@ -69,7 +71,7 @@ class ImuModel(StrictModel):
     """A MEMS IMU's white noise per reading: gyro 0.004 rad/s and accelerometer 0.03 m/s² are a consumer-grade
     part's noise densities (about 0.014 °/s/√Hz and 175 µg/√Hz) over a 250 Hz bandwidth."""
 
-    enabled: bool = True
+    enabled: StrictBool = True
     gyro: float = Field(0.004, ge=0, description="σ of each gyro axis, rad/s")
     accelerometer: float = Field(0.03, ge=0, description="σ of each accelerometer axis, m/s²")
 
