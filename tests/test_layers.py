@@ -16,6 +16,7 @@ LAYERS = {
     "yaml_source": 1,
     "sim": 2,
     "perception": 3,
+    "localisation": 3,
     "control": 4,
     "language": 4,
     "navigation": 5,

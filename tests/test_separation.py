@@ -34,7 +34,7 @@ def monitor(points, furniture=False, hands=(), people=()) -> SpeedAndSeparation:
         people=lambda: [np.array(p) for p in people],
         hands=lambda: [np.array(h) for h in hands],
     )
-    separation.update(np.zeros(2))
+    separation.update(np.zeros(3))
     return separation
 
 

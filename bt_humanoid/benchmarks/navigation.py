@@ -8,7 +8,8 @@ each run is the `navigate` behaviour (replanning and recovery included) from
 that start to one of table, counter, shelf, kitchen and living room. Judged
 in ground truth: success when the tree succeeds and the base stops within
 5 cm and 5° of the goal; contacts between the robot and anything are counted
-at every control step. Prints success, errors, contacts, average speed while
+at every control step, and so is how far the robot's belief of where it is
+(localisation) lies from where it is. Prints success, errors, contacts, average speed while
 driving, planning time (median, p95) and route length relative to a grid-A*
 route on the same map. Runs pinned to one CPU core; ``--json PATH`` also
 writes the figures.
@@ -24,7 +25,7 @@ import itertools
 import math
 import statistics
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -62,6 +63,8 @@ class Outcome:
     route_ratio: float | None
     failure: str | None
     fell: bool = False
+    localisation_errors: list[float] = field(default_factory=list)  # m, believed vs true base position, each step
+    heading_beliefs: list[float] = field(default_factory=list)  # degrees, believed vs true heading, each step
 
 
 def random_starts(count: int, rng: np.random.Generator, world: str = "apartment") -> list[tuple[float, float, float]]:
@@ -105,6 +108,8 @@ def run_one(
     track: list[tuple[float, np.ndarray, float]] = []
     floating = run.sim.robot.base.floating
     fell = False
+    believed: list[float] = []
+    heading: list[float] = []
 
     def observe() -> None:
         nonlocal fell
@@ -113,7 +118,10 @@ def run_one(
             touching = footing_removed(touching)
             fell = fell or has_fallen(run.truth.floating_base()[0][2], touching)
         contacts.extend(touching)
-        x, y, _ = run.truth.robot_pose()
+        x, y, yaw = run.truth.robot_pose()
+        belief = run.robot.base.pose()
+        believed.append(float(np.hypot(belief[0] - x, belief[1] - y)))
+        heading.append(abs(math.degrees(math.remainder(float(belief[2]) - yaw, 2 * math.pi))))
         track.append((run.sim.time, np.array([x, y]), float(np.hypot(*run.robot.base.speeds()[:2]))))
 
     run.executor.observers.append(observe)
@@ -154,6 +162,8 @@ def run_one(
         route_ratio,
         failure,
         fell,
+        believed,
+        heading,
     )
 
 
@@ -182,13 +192,16 @@ def main(argv: list[str] | None = None) -> int:
             print(
                 f"  {len(outcomes)}/{total}  ({start[0]:.2f}, {start[1]:.2f}, {start[2]:.0f}°) → {goal}: "
                 f"{outcome.position_error * 100:.1f} cm, {outcome.heading_error:.1f}°, {speed:.2f} m/s, "
-                f"{outcome.contacts} contacts: {verdict}",
+                f"{outcome.contacts} contacts, "
+                f"believed within {max(outcome.localisation_errors, default=0) * 100:.1f} cm: {verdict}",
                 flush=True,
             )
     successes = [o for o in outcomes if o.success]
     plans = [t * 1000 for o in outcomes for t in o.planning_times if t > 0]
     ratios = [o.route_ratio for o in outcomes if o.route_ratio is not None]
     drive = sum(o.drive_time for o in outcomes)
+    believed = [e * 100 for o in outcomes for e in o.localisation_errors]
+    heading = [e for o in outcomes for e in o.heading_beliefs]
     figures = {
         "runs": len(outcomes),
         "success_rate": len(successes) / len(outcomes),
@@ -201,6 +214,11 @@ def main(argv: list[str] | None = None) -> int:
         "planning_p95_ms": percentile(plans, 0.95) if plans else None,
         "route_vs_grid_astar_median": statistics.median(ratios) if ratios else None,
         "route_vs_grid_astar_max": max(ratios) if ratios else None,
+        # where the robot believed it was against where it was, every control step of every run
+        "localisation_median_cm": statistics.median(believed) if believed else None,
+        "localisation_p95_cm": percentile(believed, 0.95) if believed else None,
+        "localisation_max_cm": max(believed) if believed else None,
+        "heading_belief_p95_deg": percentile(heading, 0.95) if heading else None,
         "failures": [{"start": o.start, "goal": o.goal, "failure": o.failure} for o in outcomes if not o.success],
         "wall_s": round(time.perf_counter() - started, 1),
     }
@@ -214,6 +232,13 @@ def main(argv: list[str] | None = None) -> int:
             f"{figures['max_heading_error_deg']:.1f}° (≤ {heading_tolerance:.0f}°)"
         )
     print(f"  runs with a robot contact: {figures['runs_with_contacts']} (target 0); falls: {figures['falls']}")
+    if believed:
+        print(
+            f"  localisation error: median {figures['localisation_median_cm']:.1f} cm, "
+            f"p95 {figures['localisation_p95_cm']:.1f} cm (targets 3, 8), "
+            f"worst {figures['localisation_max_cm']:.1f} cm; "
+            f"heading p95 {figures['heading_belief_p95_deg']:.2f}°"
+        )
     print(f"  average speed while driving: {figures['average_speed']:.2f} m/s (target ≥ 0.4 m/s)")
     if plans:
         median, p95 = figures["planning_median_ms"], figures["planning_p95_ms"]

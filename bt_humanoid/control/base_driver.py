@@ -16,6 +16,7 @@ from ruckig import Trajectory
 
 from bt_humanoid.control.base_motion import SpeedMonitoring
 from bt_humanoid.control.motion import MotionHandle, plan_trajectory
+from bt_humanoid.localisation.planar import PlanarLocalisation
 from bt_humanoid.sim.robot_config import BaseConfig
 from bt_humanoid.sim.robot_io import MujocoRobotIO
 
@@ -38,15 +39,16 @@ def wrap_angle(angle: float) -> float:
 class BaseDriver(SpeedMonitoring):
     """Pose goals for the base, executed through velocity actuators (the wheeled robot's BaseMotion)."""
 
-    def __init__(self, io: MujocoRobotIO, config: BaseConfig) -> None:
+    def __init__(self, io: MujocoRobotIO, config: BaseConfig, localisation: PlanarLocalisation | None = None) -> None:
         self.io = io
         self.config = config
+        self.localisation = localisation  # None: the pose is the planar joints' own (exact)
         joints = [config.joints[axis] for axis in ("x", "y", "yaw")]
         self.actuators = np.array([io.actuator(joint) for joint in joints])
         self.lag = np.array([io.velocity_lag(joint) for joint in joints])  # s; commands lead by lag × acceleration
         self.velocity = np.zeros(3)  # commanded (planned) velocity
         self.acceleration = np.zeros(3)
-        self.reference = io.positions().copy()
+        self.reference = self.pose()
         self.handle: MotionHandle | None = None
         self.trajectory: Trajectory | None = None
         self.target = self.reference.copy()
@@ -70,11 +72,21 @@ class BaseDriver(SpeedMonitoring):
         return self.io.time
 
     def pose(self) -> np.ndarray:
-        """Odometry: (x, y, yaw) from the base joint encoders."""
+        """(x, y, yaw) on the map: localisation's belief (or, without it, the planar joints' exact pose)."""
+        if self.localisation is not None:
+            return self.localisation.pose()
         return self.io.positions().copy()
 
     def speeds(self) -> np.ndarray:
+        if self.localisation is not None:
+            return self.localisation.from_wheels(self.io.velocities())
         return self.io.velocities().copy()
+
+    def _drive(self, velocity: np.ndarray) -> None:
+        """Command a velocity (vx, vy, yaw rate) on the map: the wheels carry it out in the base's frame."""
+        if self.localisation is not None:
+            velocity = self.localisation.to_wheels(velocity)
+        self.io.command(self.actuators, velocity)
 
     def settled(self) -> bool:
         return True  # the planar joints stop where they are
@@ -151,13 +163,15 @@ class BaseDriver(SpeedMonitoring):
 
     def step(self) -> None:
         """Sample the plan, correct the tracking error, command the actuators."""
+        if self.localisation is not None:
+            self.localisation.step()
         if self.tracking:
             error = self.reference - self.pose()
             error[2] = wrap_angle(error[2])
-            self.io.command(self.actuators, self.velocity + POSITION_GAIN * error)
+            self._drive(self.velocity + POSITION_GAIN * error)
             return
         if self.trajectory is None:
-            self.io.command(self.actuators, np.zeros(3))
+            self._drive(np.zeros(3))
             return
         now = self.io.time
         step, self.last_step = now - self.last_step, now
@@ -172,7 +186,7 @@ class BaseDriver(SpeedMonitoring):
         self.acceleration = share * np.array(acceleration)
         if self.braking:
             # velocity-only braking: no position correction, just ramp the command to zero
-            self.io.command(self.actuators, self.velocity + self.lag * self.acceleration)
+            self._drive(self.velocity + self.lag * self.acceleration)
             if elapsed >= self.trajectory.duration:
                 self.trajectory, self.braking = None, False
                 self.velocity[:] = 0.0
@@ -181,7 +195,7 @@ class BaseDriver(SpeedMonitoring):
         pose = self.pose()
         error = self.reference - pose
         error[2] = wrap_angle(error[2])
-        self.io.command(self.actuators, self.velocity + self.lag * self.acceleration + POSITION_GAIN * error)
+        self._drive(self.velocity + self.lag * self.acceleration + POSITION_GAIN * error)
         self._check_progress(pose, elapsed, share)
 
     def _check_progress(self, pose: np.ndarray, elapsed: float, share: float) -> None:

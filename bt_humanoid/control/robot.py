@@ -20,6 +20,9 @@ from bt_humanoid.control.motion import REST_SPEED
 from bt_humanoid.control.payload import WristScale
 from bt_humanoid.control.walking.walking_base import WalkingBase
 from bt_humanoid.control.whole_body import WholeBodyController
+from bt_humanoid.localisation.base import BaseLocalisation
+from bt_humanoid.localisation.planar import planar_localisation
+from bt_humanoid.localisation.walking import walking_localisation
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.robot_io import MujocoRobotIO
 from bt_humanoid.sim.simulation import Simulation
@@ -36,7 +39,7 @@ class Planner(Protocol):
 class Separation(SpeedLimiter, Protocol):
     """Speed and separation monitoring: updated every control step, before anything moves."""
 
-    def update(self, base_xy: np.ndarray) -> None: ...
+    def update(self, base_pose: np.ndarray) -> None: ...
 
 
 class RobotController:
@@ -45,8 +48,10 @@ class RobotController:
     def __init__(self, sim: Simulation) -> None:
         self.config: RobotConfig = sim.robot
         self.walking: WalkingBase | None = None
+        self.localisation: BaseLocalisation | None = None
         if self.config.base.floating:  # legs: the walking controller drives them, and the upper body's servos
             self.walking = WalkingBase(sim)
+            self.walking.localisation = self.localisation = walking_localisation(sim, self.walking)
             legs = self.config.legs
             assert legs is not None
             self.body_io = MujocoRobotIO(sim, [j for j in self.config.actuated_joints if j not in legs.joints])
@@ -55,9 +60,11 @@ class RobotController:
             self.joints = JointReferenceController(self.body_io, self.config, driven=driven)
             self._upper_body = self.joints.indices(self.walking.walker.upper_body.joints)
         else:
-            base_joints = self.config.base.planar_joints
+            base_io = MujocoRobotIO(sim, self.config.base.planar_joints)
             self.body_io = MujocoRobotIO(sim, self.config.actuated_joints)
-            self.base = BaseDriver(MujocoRobotIO(sim, base_joints), self.config.base)  # skills see its BaseMotion
+            #: where the base believes it is: wheel odometry corrected by the scanner (none: exact, --ideal-sensors)
+            self.localisation = planar_localisation(sim, base_io)
+            self.base = BaseDriver(base_io, self.config.base, self.localisation)  # skills see its BaseMotion
             self.joints = JointReferenceController(self.body_io, self.config)
         self.grippers = GripperController(self.joints, self.config.grippers)
         io = self.body_io
@@ -65,7 +72,7 @@ class RobotController:
         #: whole-body motions (reaching, gaze): over a planar base, or a walking robot's upper body
         self.feedforward: BaseAccelerationFeedforward | None = None
         walker = self.walking.walker if self.walking is not None else None
-        estimated = (lambda: walker.dynamics.q) if walker is not None else None
+        estimated = self.walking.configuration if self.walking is not None else None
         self.whole_body = WholeBodyController(self.config, self.base, self.joints, ranges, estimated)
         if walker is None:
             self.feedforward = BaseAccelerationFeedforward(self.config, self.body_io, self.config.base.planar_joints)
@@ -88,7 +95,7 @@ class RobotController:
     def step(self) -> None:
         base_pose = self.base.pose()  # the encoders of this instant: nothing moves until the physics steps
         if self.separation is not None:
-            self.separation.update(base_pose[:2])
+            self.separation.update(base_pose)
         for planner in self.planners:
             planner.step()
         self.whole_body.step()  # streams references first, the controllers below then track them

@@ -178,8 +178,17 @@ class RobotStack:
         def zone(name: str, distance: float) -> None:
             self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))
 
+        scanner = SafetyScanner(model, self.sim.data, base_body, config.scanner, own=self.sim.robot_bodies, noise=noise)
+        localisation = robot.localisation
+        if localisation is not None:  # the same scans place the robot on its map
+            scanner.listeners.append(localisation.scan)
+
+            def localised(kind: str, text: str) -> None:
+                self.events.add(self.sim.time, "localisation", status=kind, text=text)
+
+            localisation.localiser.on_event = localised
         separation = SpeedAndSeparation(
-            SafetyScanner(model, self.sim.data, base_body, config.scanner, own=self.sim.robot_bodies, noise=noise),
+            scanner,
             config.safety,
             config.base.footprint_radius,
             config.base.limits.max_speed,

@@ -68,7 +68,9 @@ class Navigator:
             def noise(ranges: np.ndarray) -> np.ndarray:  # the robot's depth model, on the camera's own stream
                 return depth_ranges(sim.sensors.depth, ranges, sim.sensor_rng(f"{camera}.mapping"))
 
-            self.camera = DepthCamera(sim.model, sim.data, camera, sim.robot_root, noise=noise)
+            self.camera = DepthCamera(
+                sim.model, sim.data, camera, sim.robot_root, noise=noise, on_map=lambda p, r: sim.on_map(p, r)
+            )
         self.camera_frame = config.frames[camera][1] if camera in config.frames else None
         self.scan_period = 1.0 / config.cameras[camera].rate_hz if camera else math.inf
         self.last_scan = -math.inf

@@ -50,8 +50,11 @@ class DepthCamera:
         columns: int = 48,
         rows: int = 36,
         noise: Callable[[np.ndarray], np.ndarray] | None = None,
+        on_map: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None,
     ) -> None:
-        """``noise``: exact ranges (m, inf: nothing) → what the sensor reports (the robot's depth model)."""
+        """``noise``: exact ranges (m, inf: nothing) → what the sensor reports (the robot's depth model);
+        ``on_map``: places the camera's world pose on the robot's map (``Simulation.on_map``; none: exact)."""
+        self.on_map = on_map
         self.model, self.data = model, data
         self.camera = model.camera(camera).id
         fovy = math.radians(float(model.cam_fovy[self.camera]))
@@ -82,6 +85,9 @@ class DepthCamera:
         directions = self._rays @ rotation.T
         cast_rays(self.model, self.data, origin, directions, MAX_RANGE, self._geom_ids, self._distances)
         ranges = np.where(self._geom_ids >= 0, self._distances, np.inf)
+        if self.on_map is not None:  # rays cast where the camera is; reported where the robot believes it is
+            origin, rotation = self.on_map(origin, rotation)
+            directions = self._rays @ rotation.T
         if self.noise is not None:
             ranges = self.noise(ranges)
         own = (self._geom_ids >= 0) & self._robot_geoms[np.maximum(self._geom_ids, 0)]

@@ -103,13 +103,16 @@ class RgbdCamera:
         # depth is lost on dark surfaces: how dark they are, not how the colour stream's noise shows them
         depth = depth_image(models.depth, depth, rgb, self.focal, self.sim.sensor_rng(f"{self.name}.depth"))
         rgb = colour_image(models.colour, rgb, self.sim.sensor_rng(f"{self.name}.colour"))
+        position, rotation = self.sim.on_map(
+            data.cam_xpos[self.camera].copy(), data.cam_xmat[self.camera].reshape(3, 3)
+        )
         return RgbdFrame(
             rgb=rgb,
             depth=depth,
             focal=self.focal,
             centre=(self.width / 2, self.height / 2),
-            position=data.cam_xpos[self.camera].copy(),
-            rotation=data.cam_xmat[self.camera].reshape(3, 3).copy(),
+            position=position,
+            rotation=rotation.copy(),
             time=self.sim.time,
             noise=models.depth if models.depth.enabled else None,
         )

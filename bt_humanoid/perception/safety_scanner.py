@@ -22,7 +22,9 @@ from bt_humanoid.sim.robot_config import ScannerConfig
 
 
 class SafetyScanner:
-    """``scan()`` gives the floor points (x, y) where the rays hit something, once per scan period."""
+    """``scan()`` gives the points (x, y) where the rays hit something, in the scanner's frame (the base's: x
+    ahead, y to the left, from the base's centre), once per scan period; each fresh scan also goes to
+    ``listeners`` (points, time): localisation matches it to the map."""
 
     def __init__(
         self,
@@ -44,9 +46,10 @@ class SafetyScanner:
         self.period = 1.0 / config.rate_hz
         self.last_scan = -math.inf
         self.noise = noise
+        self.listeners: list[Callable[[np.ndarray, float], None]] = []
 
     def scan(self) -> np.ndarray | None:
-        """The hits of a fresh scan (world x, y) when one is due, else None."""
+        """The hits of a fresh scan (the scanner's frame) when one is due, else None."""
         now = self.data.time
         if now - self.last_scan < self.period - 1e-9:
             return None
@@ -73,4 +76,8 @@ class SafetyScanner:
         if self.noise is not None:
             ranges, returned = self.noise(ranges)
             hit &= returned
-        return origin[:2] + directions[hit, :2] * ranges[hit, None]
+        # measured along each ray, in the scanner's own frame: where the robot is, it does not know from here
+        points = np.stack([np.cos(self._angles[hit]), np.sin(self._angles[hit])], axis=1) * ranges[hit, None]
+        for listener in self.listeners:
+            listener(points, now)
+        return points

@@ -17,6 +17,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from bt_humanoid.localisation.scan_matcher import transform
 from bt_humanoid.perception.safety_scanner import SafetyScanner
 from bt_humanoid.sim.robot_config import SafetyDefaults
 
@@ -54,11 +55,14 @@ class SpeedAndSeparation:
         self._radii = np.zeros(0)
         self._near_gaps = np.zeros(0)  # per part: m to the nearest of those
 
-    def update(self, base_xy: np.ndarray) -> None:
-        """On each fresh scan: what is near the base or a hand, as the robot stood when the scan was taken."""
+    def update(self, base_pose: np.ndarray) -> None:
+        """On each fresh scan: what is near the base or a hand, as the robot stood when the scan was taken
+        (``base_pose``: x, y, yaw on the map, where the robot believes it is)."""
         points = self.scanner.scan()
         if points is None:
             return  # between scans: keep the last picture (the points and the parts of one instant)
+        points = transform(points, base_pose)
+        base_xy = np.asarray(base_pose[:2], dtype=float)
         if len(points):
             near_person = np.zeros(len(points), dtype=bool)
             for person in self.people():

@@ -4,8 +4,8 @@ MuJoCo renders and ray-casts the scene exactly; a real robot never sees it so. E
 reading and the sensor's own random stream (``Simulation.sensor_rng``, seeded from the run's seed, so the same
 seed gives the same noise) and returns what the sensor would report. The figures are robot.yaml's ``sensors:``
 (defaults below, each with where it comes from); ``--ideal-sensors`` (or ``BT_IDEAL_SENSORS=1``) turns every
-model off for debugging. The base's planar joints are not encoders here: where the base is comes from
-localisation, not from these models.
+model off for debugging. The base's planar joints are not encoders here: what the wheels measure is
+``OdometryModel``'s, and where the base is comes from localisation (``bt_humanoid/localisation``).
 """
 
 from __future__ import annotations
@@ -76,6 +76,18 @@ class ImuModel(StrictModel):
     accelerometer: float = Field(0.03, ge=0, description="σ of each accelerometer axis, m/s²")
 
 
+class OdometryModel(StrictModel):
+    """The base's odometry: what its wheels say it moved. Each run draws a scale error per axis (worn or
+    squashed wheels, a wrong track width; about 2 % is what calibrated mobile bases keep to) and every increment
+    has white noise that grows with the distance moved (wheels slip on the floor). Localisation corrects it;
+    with it off, the base's pose is exact."""
+
+    enabled: StrictBool = True
+    scale: float = Field(0.02, ge=0, description="σ of each axis's scale error, drawn once a run (x, y, yaw)")
+    noise: float = Field(0.01, ge=0, description="m σ of the position error per √m moved")
+    yaw_noise: float = Field(0.02, ge=0, description="rad σ of the heading error per √rad turned")
+
+
 class SensorModels(StrictModel):
     """robot.yaml's ``sensors:``: how far each of the robot's sensors is from the truth (on by default)."""
 
@@ -84,6 +96,7 @@ class SensorModels(StrictModel):
     scanner: RangeModel = RangeModel()
     encoders: EncoderModel = EncoderModel()
     imu: ImuModel = ImuModel()
+    odometry: OdometryModel = OdometryModel()
 
     @classmethod
     def ideal(cls) -> SensorModels:
@@ -94,6 +107,7 @@ class SensorModels(StrictModel):
             scanner=RangeModel(enabled=False),
             encoders=EncoderModel(enabled=False),
             imu=ImuModel(enabled=False),
+            odometry=OdometryModel(enabled=False),
         )
 
 

@@ -38,6 +38,9 @@ class Simulation:
         #: what the robot's sensors add to the truth: robot.yaml's models, or none (--ideal-sensors)
         self.sensors = SensorModels.ideal() if ideal_sensors_requested() else robot.sensors
         self._sensor_rngs: dict[str, np.random.Generator] = {}
+        #: places a pose a body-mounted sensor measured in the world (MuJoCo's frame) on the robot's map: through
+        #: where the robot believes its base is (set by localisation; exact where there is none)
+        self.on_map: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] = _exact_pose
         if scene is None and world.scene is not None:
             scene = load_scene(world, world.scene)
         self.scene = scene
@@ -213,3 +216,7 @@ class Simulation:
             ):
                 return i
         raise KeyError(f"no actuator drives joint '{joint}'")
+
+
+def _exact_pose(position: np.ndarray, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return position, rotation

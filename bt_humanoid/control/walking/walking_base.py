@@ -12,8 +12,10 @@ control rate, turns what was asked into what the walker takes:
   reference's velocity plus a correction of the error, in the body's frame, under the base's limits;
 - ``brake`` stops within two steps.
 
-Odometry (``pose``, ``speeds``) is the state estimator's: the pelvis from the IMU, encoders and foot contacts,
-never the simulator's free joint. Speed and separation monitoring scales every velocity as on the wheeled base.
+Odometry (``odometry_pose``) is the state estimator's: the pelvis from the IMU, encoders and foot contacts,
+never the simulator's free joint; ``pose`` and ``speeds`` are on the map, the odometry corrected by the base
+scanner (``localisation``, set by the robot). Speed and separation monitoring scales every velocity as on the
+wheeled base.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import numpy as np
 from bt_humanoid.control.base_motion import SpeedMonitoring
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.walking.walker import SET_OFF_DISTANCE, Phase, WalkingController
+from bt_humanoid.localisation.walking import WalkingLocalisation
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.standing import standing_posture
 
@@ -48,6 +51,8 @@ class WalkingBase(SpeedMonitoring):
         self.walker = WalkingController(sim, posture)
         sim.physics_controllers.append(self.walker.step)
         self.walker.observe()  # odometry from the first instant, before any physics step
+        #: the map's correction of the walker's odometry (none: the odometry is the pose, --ideal-sensors)
+        self.localisation: WalkingLocalisation | None = None
         stance = standing_posture(sim.robot, posture=posture)
         #: the pelvis from the centre of mass, which stands over the middle of the feet, in the body's frame: the
         #: stance's to start with, then as measured (``step``)
@@ -70,16 +75,32 @@ class WalkingBase(SpeedMonitoring):
     def time(self) -> float:
         return self.sim.time
 
-    def pose(self) -> np.ndarray:
-        """(x, y, yaw) of the pelvis, from the state estimator."""
+    def odometry_pose(self) -> np.ndarray:
+        """(x, y, yaw) of the pelvis in the state estimator's own frame (legged odometry: it drifts)."""
         state = self.walker.state
         assert state is not None
         return np.array([state.position[0], state.position[1], state.yaw])
 
+    def pose(self) -> np.ndarray:
+        """(x, y, yaw) of the pelvis on the map: the odometry, corrected by localisation where there is one."""
+        if self.localisation is not None:
+            return self.localisation.pose()
+        return self.odometry_pose()
+
+    def configuration(self) -> np.ndarray:
+        """The whole robot's configuration as the walker estimates it (Pinocchio's q), its pelvis on the map: what
+        the upper body's motions stand on."""
+        q = self.walker.dynamics.q
+        return self.localisation.configuration_on_map(q) if self.localisation is not None else q
+
     def speeds(self) -> np.ndarray:
         state = self.walker.state
         assert state is not None
-        return np.array([state.linear_velocity[0], state.linear_velocity[1], state.angular_velocity[2]])
+        vx, vy, wz = state.linear_velocity[0], state.linear_velocity[1], state.angular_velocity[2]
+        if self.localisation is not None:  # the odometry's axes turned onto the map's
+            c, s = math.cos(self.localisation.turn()), math.sin(self.localisation.turn())
+            vx, vy = c * vx - s * vy, s * vx + c * vy
+        return np.array([vx, vy, wz])
 
     def settled(self) -> bool:
         """Standing after the last step, the centre of mass come to rest over the middle of the feet."""
@@ -141,14 +162,16 @@ class WalkingBase(SpeedMonitoring):
 
     def step(self) -> None:
         """Turn the goal or the streamed reference into the walker's command (at the control rate)."""
+        if self.localisation is not None:
+            self.localisation.step()
         pose = self.pose()
         self._yaw += wrap(pose[2] - self._last_yaw)
         self._last_yaw = pose[2]
         # the pelvis from the centre of mass, which the walker stands over the middle of the feet: it moves when
         # the arms do (tucked, holding something), and a goal for the pelvis is one for the feet offset by it
-        com = self.walker.dynamics.com
-        c, s = math.cos(pose[2]), math.sin(pose[2])
-        dx, dy = pose[0] - com[0], pose[1] - com[1]
+        com, odometry = self.walker.dynamics.com, self.odometry_pose()  # both in the estimator's frame
+        c, s = math.cos(odometry[2]), math.sin(odometry[2])
+        dx, dy = odometry[0] - com[0], odometry[1] - com[1]
         measured = np.array([c * dx + s * dy, -s * dx + c * dy])
         self.stance_offset += OFFSET_FILTER * (measured - self.stance_offset)
         if self.target is not None:
@@ -188,7 +211,10 @@ class WalkingBase(SpeedMonitoring):
         """Have the walker put the pelvis on (x, y, yaw): the middle of the feet ``stance_offset`` from it."""
         c, s = math.cos(yaw), math.sin(yaw)
         ox, oy = self.stance_offset
-        self.walker.walk_to(x - (c * ox - s * oy), y - (s * ox + c * oy), yaw, speed, yaw_rate)
+        feet = np.array([x - (c * ox - s * oy), y - (s * ox + c * oy), yaw])
+        if self.localisation is not None:  # the walker steps in its own odometry's frame
+            feet = self.localisation.to_odometry(feet)
+        self.walker.walk_to(float(feet[0]), float(feet[1]), float(feet[2]), speed, yaw_rate)
 
     def _follow_reference(self, pose: np.ndarray) -> None:
         assert self.reference is not None
