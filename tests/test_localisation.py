@@ -14,6 +14,7 @@ from bt_humanoid.localisation.localiser import LOST_AFTER, Localiser, search_map
 from bt_humanoid.localisation.odometry import WheelOdometry, apply_increment, body_increment
 from bt_humanoid.localisation.scan_map import ScanMap
 from bt_humanoid.localisation.scan_matcher import match_scan, transform
+from bt_humanoid.safety.monitors import LostMonitor
 from bt_humanoid.sim.sensor_models import IDEAL_SENSORS_VARIABLE, OdometryModel
 
 RESOLUTION = 0.01
@@ -176,3 +177,14 @@ def test_the_wheeled_base_drives_on_its_belief_and_keeps_it_within_centimetres()
     assert outcome.success, outcome.failure
     assert max(outcome.localisation_errors) < 0.06
     assert statistics.median(outcome.localisation_errors) < 0.02
+
+
+def test_a_lost_robot_stops_its_mission_and_says_what_would_help():
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    stack.close()
+    localisation = stack.robot.localisation
+    assert localisation is not None
+    monitor = LostMonitor(localisation)
+    assert monitor.check(0.0) is None
+    localisation.localiser.lost = True
+    assert "do not know where I am" in (monitor.check(0.0) or "")

@@ -27,6 +27,7 @@ from bt_humanoid.safety.monitors import (
     DroppedMonitor,
     FallMonitor,
     JointLimitMonitor,
+    LostMonitor,
     SafetySupervisor,
     StopRequestMonitor,
     StrainMonitor,
@@ -122,6 +123,8 @@ class MissionRun:
             TimeBudgetMonitor(self.time_budget, sim.time),
             WorkspaceMonitor(robot, np.array(stack.world.bounds), defaults.min_hand_height),
         ]
+        if robot.localisation is not None:  # a robot that lost its place on the map stops
+            monitors.append(LostMonitor(robot.localisation))
         if robot.walking is not None and robot_config.legs is not None:  # a biped can fall
             legs = robot_config.legs
             feet = {sim.model.body(leg.foot).id for leg in (legs.left, legs.right)}

@@ -35,7 +35,9 @@ class ScanMap:
         to_free = cv2.distanceTransform(1 - free, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * resolution
         half = 0.5 * resolution
         self.distance = np.where(occupied, -(to_free - half), to_occupied - half).astype(np.float64)
-        self.gradient_y, self.gradient_x = np.gradient(self.distance, resolution)
+        gradient_y, gradient_x = np.gradient(self.distance, resolution)
+        # one array of (distance, ∂/∂x, ∂/∂y) per cell: a lookup gathers each corner's three at once
+        self._fields = np.stack([self.distance, gradient_x, gradient_y], axis=-1)
         self.occupied = occupied
 
     @classmethod
@@ -64,14 +66,13 @@ class ScanMap:
         grid = (np.asarray(points, dtype=float) - self.origin) / self.resolution - 0.5
         col0, row0 = np.floor(grid[:, 0]).astype(int), np.floor(grid[:, 1]).astype(int)
         on_map = (col0 >= 0) & (row0 >= 0) & (col0 < cols - 1) & (row0 < rows - 1)
-        distance = np.full(len(grid), self.outside)
-        gx, gy = np.zeros(len(grid)), np.zeros(len(grid))
-        if not on_map.any():
-            return distance, gx, gy
-        c, r = col0[on_map], row0[on_map]
-        fx, fy = grid[on_map, 0] - c, grid[on_map, 1] - r
-        weights = ((1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy)
-        corners = ((r, c), (r, c + 1), (r + 1, c), (r + 1, c + 1))
-        for field, out in ((self.distance, distance), (self.gradient_x, gx), (self.gradient_y, gy)):
-            out[on_map] = sum(w * field[rc] for w, rc in zip(weights, corners, strict=True))
-        return distance, gx, gy
+        values = np.zeros((len(grid), 3))
+        values[:, 0] = self.outside
+        if on_map.any():
+            c, r = col0[on_map], row0[on_map]
+            fx, fy = (grid[on_map, 0] - c)[:, None], (grid[on_map, 1] - r)[:, None]
+            fields = self._fields
+            values[on_map] = (1 - fy) * ((1 - fx) * fields[r, c] + fx * fields[r, c + 1]) + fy * (
+                (1 - fx) * fields[r + 1, c] + fx * fields[r + 1, c + 1]
+            )
+        return values[:, 0], values[:, 1], values[:, 2]

@@ -22,6 +22,7 @@ from py_trees.behaviour import Behaviour
 
 from bt_humanoid.control.gripper import GripperController
 from bt_humanoid.control.robot import REST_SPEED, RobotController
+from bt_humanoid.localisation.base import BaseLocalisation
 from bt_humanoid.perception.world_model import WorldModel
 
 OVERSPEED_TIME = 0.5  # s a joint must stay over its speed limit before the guard trips (a knock is shorter)
@@ -234,6 +235,25 @@ class WorkspaceMonitor:
                     f"the {side} hand is {z * 100:.0f} cm above the floor (lowest allowed {self.min_hand_height:g} m)"
                 )
         return None
+
+
+class LostMonitor:
+    """Fires when localisation has lost the robot's place on the map: no scan fits where it believes it is, and
+    a search of the whole map found no clear answer. Driving on a belief nobody trusts is not safe; the robot
+    stops and says what would help. It keeps searching, so the next mission may find it again."""
+
+    name = "lost"
+
+    def __init__(self, localisation: BaseLocalisation) -> None:
+        self.localisation = localisation
+
+    def check(self, now: float) -> str | None:
+        if not self.localisation.localiser.lost:
+            return None
+        return (
+            "I do not know where I am: my scans fit nowhere on the map. Move me where I can see the walls or the "
+            "furniture, or clear what surrounds me, and ask again"
+        )
 
 
 class TimeBudgetMonitor:
