@@ -343,3 +343,16 @@ def test_a_run_logged_to_a_file_says_each_episode_as_it_ends(tmp_path, monkeypat
     said = capsys.readouterr().out
     assert "episode 0: succeeded (1/3 done)" in said and "episode 2: succeeded (3/3 done)" in said
     assert "episode 1 (bring me the red cube): safety stop: collision" in said
+
+
+def test_localisation_error_is_summarised_over_the_episodes_that_localise():
+    localised = [
+        episode(0, True, None) | {"localisation_p95_cm": 1.0, "localisation_max_cm": 2.0},
+        episode(1, True, None) | {"localisation_p95_cm": 3.0, "localisation_max_cm": 7.5},
+        episode(2, True, None) | {"localisation_p95_cm": None, "localisation_max_cm": None},  # --ideal-sensors
+        episode(3, True, None),  # saved before localisation was watched
+    ]
+    figures = summarize(localised, wall_s=20.0, workers=1)
+    assert figures["localisation_p95_cm_median"] == pytest.approx(2.0)
+    assert figures["localisation_max_cm"] == 7.5
+    assert summarize([episode(0, True, None)], wall_s=1.0, workers=1)["localisation_max_cm"] is None

@@ -297,6 +297,8 @@ def _print(console: Console, figures: dict[str, Any]) -> None:
         f"p95 {ms(latency['p95'], 's', 2)} over {latency['count']}",
         f"plan {ms(figures['plan_ms_median'])}, camera look {ms(figures['look_ms_median'])}, "
         f"whole-body QP {ms(figures['qp_ms_median'], 'ms', 3)} (medians)",
+        f"localisation error: p95 {ms(figures.get('localisation_p95_cm_median'), 'cm')} (median over episodes), "
+        f"worst {ms(figures.get('localisation_max_cm'), 'cm')}",
         f"real-time factor per core {figures['real_time_factor_per_core']:.1f}×; "
         f"wall {figures['wall_s']:.0f} s with {figures['workers']} worker(s)",
     ]

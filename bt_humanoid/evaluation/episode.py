@@ -219,6 +219,7 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
     injector = _arm(fault, run, draw) if fault is not None else None
     touched = watch_people(run, stack)
     fell = watch_balance(run, stack)
+    believed = watch_localisation(run, stack)
     result = run.execute()
     if isinstance(injector, fault_kinds.NewCommand) and injector.fired is not None:
         rest = next((e["t"] for e in reversed(result.events.events) if e["event"] in ("rest", "moving")), None)
@@ -228,10 +229,20 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
         follow = _planned(command, suite, stack, figures)
         if isinstance(follow, str):
             return episode_verdict(
-                stack, result, figures, expect, failure=follow, injector=injector, touched=touched, fell=fell
+                stack,
+                result,
+                figures,
+                expect,
+                failure=follow,
+                injector=injector,
+                touched=touched,
+                fell=fell,
+                believed=believed,
             )
         result = MissionRun(stack, follow).execute()
-    return episode_verdict(stack, result, figures, expect, injector=injector, touched=touched, fell=fell)
+    return episode_verdict(
+        stack, result, figures, expect, injector=injector, touched=touched, fell=fell, believed=believed
+    )
 
 
 def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:
@@ -249,6 +260,22 @@ def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:
 
     stack.observers.append(watch)
     return touched
+
+
+def watch_localisation(run: MissionRun, stack: RobotStack) -> list[float]:
+    """How far (cm) the robot's belief of where its base is lies from where it is, every control step, filled
+    while the run steps; empty for a robot whose base pose is exact (--ideal-sensors)."""
+    errors: list[float] = []
+    if run.robot.localisation is None:
+        return errors
+
+    def watch() -> None:
+        x, y, _ = run.truth.robot_pose()
+        belief = run.robot.base.pose()
+        errors.append(100.0 * float(np.hypot(belief[0] - x, belief[1] - y)))
+
+    stack.observers.append(watch)
+    return errors
 
 
 def watch_balance(run: MissionRun, stack: RobotStack) -> list[float]:
@@ -322,6 +349,7 @@ def episode_verdict(
     injector: fault_kinds.Injector | None = None,
     touched: list[float] | None = None,
     fell: list[float] | None = None,
+    believed: list[float] | None = None,
 ) -> dict[str, Any]:
     """Success in ground truth, and the figures the suite aggregates."""
     header = MissionHeader.model_validate({"mission": "expect", "success": expect or []})
@@ -360,4 +388,6 @@ def episode_verdict(
         "look_ms_median": round(statistics.median(looks), 3) if looks else None,
         "qp_ms_median": round(statistics.median(qp), 4) if qp else None,
         "qp_ms_p95": round(float(np.percentile(qp, 95)), 4) if qp else None,
+        "localisation_p95_cm": round(float(np.percentile(believed, 95)), 2) if believed else None,
+        "localisation_max_cm": round(max(believed), 2) if believed else None,
     }

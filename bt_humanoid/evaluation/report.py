@@ -81,6 +81,13 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
         "look_ms_median": _median([e["look_ms_median"] for e in episodes if e["look_ms_median"] is not None]),
         "qp_ms_median": _median([e["qp_ms_median"] for e in episodes if e["qp_ms_median"] is not None]),
         "qp_ms_p95_median": _median([e["qp_ms_p95"] for e in episodes if e["qp_ms_p95"] is not None]),
+        # where the robot believed its base was against where it was: each episode's p95 (their median), the worst
+        "localisation_p95_cm_median": _median(
+            [e["localisation_p95_cm"] for e in episodes if e.get("localisation_p95_cm") is not None]
+        ),
+        "localisation_max_cm": max(
+            (e["localisation_max_cm"] for e in episodes if e.get("localisation_max_cm") is not None), default=None
+        ),
         "real_time_factor_per_core": sim / busy if busy else None,
         "wall_s": round(wall_s, 1),
         "workers": workers,
