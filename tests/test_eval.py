@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import cProfile
 import json
+import math
 import os
 from pathlib import Path
 
@@ -13,6 +15,7 @@ from bt_humanoid.control.stance import deepest_reach
 from bt_humanoid.errors import UserError
 from bt_humanoid.evaluation.command import eval_main
 from bt_humanoid.evaluation.episode import Draw, _probe
+from bt_humanoid.evaluation.profiling import top_costs
 from bt_humanoid.evaluation.report import summarize, wilson_interval
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.testing.spots import REACH_SLACK, reachable_spot
@@ -356,3 +359,29 @@ def test_localisation_error_is_summarised_over_the_episodes_that_localise():
     assert figures["localisation_p95_cm_median"] == pytest.approx(2.0)
     assert figures["localisation_max_cm"] == 7.5
     assert summarize([episode(0, True, None)], wall_s=1.0, workers=1)["localisation_max_cm"] is None
+
+
+def test_profile_needs_this_process_to_run_the_episodes(tmp_path, capsys):
+    assert eval_main(["smoke", "--workers", "2", "--profile", str(tmp_path / "run.prof")]) == 2
+    assert "--workers 1" in capsys.readouterr().err
+    assert not (tmp_path / "run.prof").exists()
+
+
+def test_top_costs_are_per_simulated_second_and_ordered_by_their_own_time():
+    def busy(n: int) -> float:
+        return sum(math.sqrt(i) for i in range(n))
+
+    def idle() -> None:
+        pass
+
+    profile = cProfile.Profile()
+    profile.enable()
+    busy(200_000)
+    for _ in range(10):
+        idle()
+    profile.disable()
+    costs = top_costs(profile, simulated=2.0, count=50)
+    assert [c.own_ms for c in costs] == sorted((c.own_ms for c in costs), reverse=True)
+    named = {c.function.split("(")[-1].rstrip(")"): c for c in costs}
+    assert named["idle"].calls == pytest.approx(5.0)  # 10 calls over 2 simulated seconds
+    assert named["busy"].total_ms >= named["busy"].own_ms > named["idle"].own_ms

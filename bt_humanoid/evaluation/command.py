@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cProfile
 import json
 import subprocess
 import sys
@@ -15,6 +16,7 @@ from rich.table import Table
 
 from bt_humanoid.cli import EXIT_OK, _fail_invalid, _Parser
 from bt_humanoid.errors import UserError
+from bt_humanoid.evaluation.profiling import save, top_costs
 from bt_humanoid.evaluation.report import markdown, summarize
 from bt_humanoid.evaluation.suite import load_suite
 from bt_humanoid.paths import missions_dir
@@ -61,6 +63,13 @@ def _parser() -> _Parser:
     parser.add_argument("--address", help="Ray cluster address for --backend ray (default: start a local Ray)")
     parser.add_argument("--json", type=Path, help="write figures and episodes here (default: bt-eval-SUITE.json)")
     parser.add_argument("--ideal-sensors", action="store_true", help="exact sensors: no noise, nothing lost")
+    parser.add_argument(
+        "--profile",
+        type=Path,
+        metavar="PATH",
+        help="run the episodes under cProfile (one worker): save the statistics to PATH, print the top costs per "
+        "simulated second",
+    )
     return parser
 
 
@@ -87,6 +96,8 @@ def eval_main(argv: list[str] | None = None) -> int:
             raise UserError(f"--seed {args.seed}: give 0 or more")
         if args.first < 0:
             raise UserError(f"--first {args.first}: give 0 or more")
+        if args.profile is not None and (args.workers != 1 or args.backend != "local"):
+            raise UserError("--profile profiles this process: give --workers 1 and the local backend")
         file = _suite_file(args.suite)
         suite, _ = load_suite(file, args.scene, args.robot)
         if args.scene is not None:
@@ -111,13 +122,27 @@ def eval_main(argv: list[str] | None = None) -> int:
         commit = source_commit()  # before the run: the code the episodes ran, whatever is edited meanwhile
         if args.ideal_sensors:
             request_ideal_sensors()  # the workers inherit it
+        profile = cProfile.Profile() if args.profile is not None else None
+        if profile is not None:
+            profile.enable()
         records, wall = _run(str(file.resolve()), indices, seed, args, console)
+        if profile is not None:
+            profile.disable()
+            _print_profile(profile, args.profile, records, console)
     except UserError as error:
         return _fail_invalid(error)
     command = " ".join(["bt-eval", *(argv if argv is not None else sys.argv[1:])])
     run = {"suite": suite.suite, "file": display_path(file), "seed": seed, "robot": suite.robot, "commit": commit}
     run["sensors"] = "ideal" if ideal_sensors_requested() else "modelled"  # the flag, or BT_IDEAL_SENSORS=1
     return _report({**run, "command": command}, records, wall, args.workers, args.json, console)
+
+
+def _print_profile(profile: cProfile.Profile, path: Path, records: list[dict[str, Any]], console: Console) -> None:
+    simulated = sum(r.get("sim_time", 0.0) for r in records) or 1.0
+    save(profile, path)
+    console.print(f"  profile: {path} ({simulated:.0f} s simulated); the top costs, CPU ms per simulated second:")
+    for cost in top_costs(profile, simulated, 10):
+        console.print(f"    {cost.own_ms:8.1f} own {cost.total_ms:8.1f} total {cost.calls:8.0f} calls  {cost.function}")
 
 
 def _report(
