@@ -122,7 +122,8 @@ def eval_main(argv: list[str] | None = None) -> int:
         commit = source_commit()  # before the run: the code the episodes ran, whatever is edited meanwhile
         if args.ideal_sensors:
             request_ideal_sensors()  # the workers inherit it
-        profile = cProfile.Profile() if args.profile is not None else None
+        # CPU time, not wall time: a shared core does not inflate the figures
+        profile = cProfile.Profile(time.process_time) if args.profile is not None else None
         if profile is not None:
             profile.enable()
         records, wall = _run(str(file.resolve()), indices, seed, args, console)
