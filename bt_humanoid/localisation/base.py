@@ -8,8 +8,15 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from bt_humanoid.localisation.localiser import Localiser
+from bt_humanoid.sim.simulation import Simulation
 
 MATCH_PERIOD = 0.1  # s between scans matched to the map (the scanner gives more; 10 Hz keeps up with 1 m/s)
+
+
+def localises(sim: Simulation) -> bool:
+    """Whether the robot localises itself: its odometry is modelled (not --ideal-sensors) and it has a base
+    scanner to correct it with; otherwise its base pose is its odometry's."""
+    return sim.sensors.odometry.enabled and sim.robot.scanner is not None
 
 
 class BaseLocalisation(ABC):

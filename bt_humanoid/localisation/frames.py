@@ -19,6 +19,13 @@ def inverse(a: np.ndarray) -> np.ndarray:
     return np.array([-(c * a[0] + s * a[1]), s * a[0] - c * a[1], -a[2]])
 
 
+def turned(velocity: np.ndarray, angle: float) -> np.ndarray:
+    """A planar velocity (vx, vy, yaw rate) with its linear part turned by ``angle`` about z."""
+    c, s = math.cos(angle), math.sin(angle)
+    vx, vy, wz = (float(v) for v in velocity)
+    return np.array([c * vx - s * vy, s * vx + c * vy, wz])
+
+
 def place_on_map(
     position: np.ndarray, rotation: np.ndarray, truth: np.ndarray, belief: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:

@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from bt_humanoid.localisation.base import BaseLocalisation
-from bt_humanoid.localisation.frames import place_on_map
+from bt_humanoid.localisation.base import BaseLocalisation, localises
+from bt_humanoid.localisation.frames import place_on_map, turned
 from bt_humanoid.localisation.localiser import ODOMETRY_SHARE, Localiser
 from bt_humanoid.localisation.odometry import WheelOdometry, body_increment
 from bt_humanoid.localisation.scan_map import ScanMap
@@ -47,15 +47,11 @@ class PlanarLocalisation(BaseLocalisation):
     def to_wheels(self, velocity: np.ndarray) -> np.ndarray:
         """A velocity (vx, vy, yaw rate) wanted on the map → what the planar joints carry out: the same
         velocity in the base's frame, wherever the base truly faces."""
-        c, s = math.cos(-self._heading_error()), math.sin(-self._heading_error())
-        vx, vy, wz = (float(v) for v in velocity)
-        return np.array([c * vx - s * vy, s * vx + c * vy, wz])
+        return turned(velocity, -self._heading_error())
 
     def from_wheels(self, velocity: np.ndarray) -> np.ndarray:
         """The base's true velocity as the robot places it on its map (the inverse of ``to_wheels``)."""
-        c, s = math.cos(self._heading_error()), math.sin(self._heading_error())
-        vx, vy, wz = (float(v) for v in velocity)
-        return np.array([c * vx - s * vy, s * vx + c * vy, wz])
+        return turned(velocity, self._heading_error())
 
     def on_map(self, position: np.ndarray, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A world pose measured by a sensor on the robot (MuJoCo's), placed on the map through the belief."""
@@ -66,8 +62,7 @@ def planar_localisation(sim: Simulation, io: MujocoRobotIO) -> PlanarLocalisatio
     """The planar base's localisation, starting where the robot was put down (it is told where it starts, as a
     real robot is given its initial pose); None where the base's pose is exact: odometry off (--ideal-sensors),
     or no scanner to correct it with."""
-    scanner = sim.robot.scanner
-    if not sim.sensors.odometry.enabled or scanner is None:
+    if not localises(sim):
         return None
     scan_map = ScanMap.for_robot(sim)
     odometry = WheelOdometry(sim.sensors.odometry, sim.sensor_rng("odometry"))

@@ -15,7 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
-from bt_humanoid.localisation.base import BaseLocalisation
+from bt_humanoid.localisation.base import BaseLocalisation, localises
 from bt_humanoid.localisation.frames import compose, inverse, place_on_map
 from bt_humanoid.localisation.localiser import Localiser
 from bt_humanoid.localisation.odometry import body_increment
@@ -75,8 +75,7 @@ class WalkingLocalisation(BaseLocalisation):
 def walking_localisation(sim: Simulation, base: OdometryBase) -> WalkingLocalisation | None:
     """A walking base's localisation, from where its estimator starts; None without a scanner to correct the
     odometry with, or with exact sensors (--ideal-sensors: the walker's odometry is then the pose)."""
-    scanner = sim.robot.scanner
-    if not sim.sensors.odometry.enabled or scanner is None:
+    if not localises(sim):
         return None
     root = sim.model.body(sim.robot_root).id
 

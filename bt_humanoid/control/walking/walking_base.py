@@ -27,6 +27,7 @@ import numpy as np
 from bt_humanoid.control.base_motion import SpeedMonitoring
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.walking.walker import SET_OFF_DISTANCE, Phase, WalkingController
+from bt_humanoid.localisation.frames import turned
 from bt_humanoid.localisation.walking import WalkingLocalisation
 from bt_humanoid.sim.simulation import Simulation
 from bt_humanoid.sim.standing import standing_posture
@@ -96,11 +97,10 @@ class WalkingBase(SpeedMonitoring):
     def speeds(self) -> np.ndarray:
         state = self.walker.state
         assert state is not None
-        vx, vy, wz = state.linear_velocity[0], state.linear_velocity[1], state.angular_velocity[2]
+        speeds = np.array([state.linear_velocity[0], state.linear_velocity[1], state.angular_velocity[2]])
         if self.localisation is not None:  # the odometry's axes turned onto the map's
-            c, s = math.cos(self.localisation.turn()), math.sin(self.localisation.turn())
-            vx, vy = c * vx - s * vy, s * vx + c * vy
-        return np.array([vx, vy, wz])
+            return turned(speeds, self.localisation.turn())
+        return speeds
 
     def settled(self) -> bool:
         """Standing after the last step, the centre of mass come to rest over the middle of the feet."""
