@@ -9,6 +9,7 @@ controlled joint, in that order.
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import mujoco
@@ -60,6 +61,27 @@ def cached_frame_id(model: pin.Model, cache: dict[str, int], frame: str) -> int:
     return cache[frame]
 
 
+def controlled_indices(model: pin.Model, config: RobotConfig, joints: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Where each of ``joints`` sits in Pinocchio's configuration q and velocity v.
+
+    A floating base is not among them: it stays where the caller leaves it.
+    """
+    base = config.base.planar_joints
+    q_index, v_index = [], []
+    for joint in joints:
+        if joint in base:
+            # MJCF base x/y/yaw become one composite joint in Pinocchio, in that order
+            composite = model.joints[model.getJointId(f"Composite_{base[0]}")]
+            offset = base.index(joint)
+            q_index.append(composite.idx_q + offset)
+            v_index.append(composite.idx_v + offset)
+        else:
+            pin_joint = model.joints[model.getJointId(joint)]
+            q_index.append(pin_joint.idx_q)
+            v_index.append(pin_joint.idx_v)
+    return np.array(q_index, dtype=int), np.array(v_index, dtype=int)
+
+
 class RobotKinematics:
     """Forward kinematics and frame Jacobians over the controlled joints."""
 
@@ -69,28 +91,21 @@ class RobotKinematics:
         self.joints = list(joints)
         self.q = pin.neutral(self.model)
         self.positions = np.zeros(len(self.joints))  # controlled joints, as last set by update()
-        base = config.base.planar_joints  # a floating base stays where update() leaves it: not controlled here
-        q_index, v_index = [], []
-        for joint in self.joints:
-            if joint in base:
-                # MJCF base x/y/yaw become one composite joint in Pinocchio, in that order
-                composite = self.model.joints[self.model.getJointId(f"Composite_{base[0]}")]
-                offset = base.index(joint)
-                q_index.append(composite.idx_q + offset)
-                v_index.append(composite.idx_v + offset)
-            else:
-                pin_joint = self.model.joints[self.model.getJointId(joint)]
-                q_index.append(pin_joint.idx_q)
-                v_index.append(pin_joint.idx_v)
-        self._q_index = np.array(q_index)
-        self._v_index = np.array(v_index)
+        self._q_index, self._v_index = controlled_indices(self.model, config, self.joints)
         self._frame_ids: dict[str, int] = {}
         self._jacobians: dict[str, np.ndarray] = {}  # per update(): tasks and limits ask for the same frames
+        self._positions: dict[str, np.ndarray] = {}  # per update(), as the Jacobians: Pinocchio copies on each read
+        self._rotations: dict[str, np.ndarray] = {}
         self._placed_q: np.ndarray | None = None  # the configuration the frame placements are of
         self._joint_jacobians = False  # whether Pinocchio's joint Jacobians are of it too (computed on demand)
 
     def index(self, joint: str) -> int:
         return self.joints.index(joint)
+
+    def parameter(self, read: Callable[[], np.ndarray], shape: tuple[int, int]) -> np.ndarray:
+        """A number a task reads that may change during a goal (a moving target): here, its value now. (A
+        ``SymbolicKinematics`` makes it an input of the compiled QP instead.)"""
+        return np.asarray(read(), dtype=float)
 
     def update(self, positions: np.ndarray) -> None:
         """Set the controlled joints (other joints stay at their last value) and recompute kinematics: frame
@@ -103,6 +118,8 @@ class RobotKinematics:
         self._placed_q = self.q.copy()
         self._joint_jacobians = False
         self._jacobians.clear()
+        self._positions.clear()
+        self._rotations.clear()
 
     def _set(self, positions: np.ndarray) -> None:
         self.positions = np.array(positions, dtype=float)
@@ -122,6 +139,18 @@ class RobotKinematics:
     def pose(self, frame: str) -> pin.SE3:
         """World pose of a frame (site, body or camera name)."""
         return self.data.oMf[self.frame_id(frame)]
+
+    def position(self, frame: str) -> np.ndarray:
+        """World position of a frame (read only: shared until the next update)."""
+        if frame not in self._positions:
+            self._positions[frame] = self.pose(frame).translation
+        return self._positions[frame]
+
+    def rotation(self, frame: str) -> np.ndarray:
+        """World orientation of a frame as a rotation matrix (read only: shared until the next update)."""
+        if frame not in self._rotations:
+            self._rotations[frame] = self.pose(frame).rotation
+        return self._rotations[frame]
 
     def jacobian(self, frame: str) -> np.ndarray:
         """6 × n Jacobian (linear; angular) of the frame origin in world-aligned axes."""

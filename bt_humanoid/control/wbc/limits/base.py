@@ -8,14 +8,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.maths import Value, minimum, where
 
 
 @dataclass
 class Inequality:
-    """``lower ≤ G Δq`` (row-wise); an empty G means no constraint this step."""
+    """``lower ≤ G Δq`` (row-wise); an empty G means no constraint."""
 
-    G: np.ndarray
-    lower: np.ndarray
+    G: Value
+    lower: Value
 
     @classmethod
     def none(cls, n: int) -> Inequality:
@@ -25,7 +26,7 @@ class Inequality:
 RECOVERY_SPEED = 0.1  # m/s at most that a violated limit demands to be made good: keeps the QP feasible
 
 
-def gap_bound(gain: float, gap: float, dt: float) -> float:
+def gap_bound(gain: float, gap: Value, dt: float) -> Value:
     """Lower bound on the change of a distance that must stay ≥ its limit, ``gap`` = limit − distance.
 
     Satisfied (gap ≤ 0): the distance may shrink by ``gain`` times its slack
@@ -33,11 +34,19 @@ def gap_bound(gain: float, gap: float, dt: float) -> float:
     target that started inside): it must grow, but no faster than
     RECOVERY_SPEED, which the joints can always deliver.
     """
-    return min(gain * gap, RECOVERY_SPEED * dt) if gap > 0 else gain * gap
+    return where(gap > 0, minimum(gain * gap, RECOVERY_SPEED * dt), gain * gap)
+
+
+FREE = -np.inf  # the lower bound of a row that does not hold this step (a wall too far away to matter)
 
 
 class Limit(ABC):
-    """A hard constraint of the whole-body QP."""
+    """A hard constraint of the whole-body QP.
+
+    Its rows are the same every step (the compiled QP has a fixed shape); a
+    row that does not apply now gets the lower bound ``FREE``. Written with
+    ``maths``' operations, like the tasks.
+    """
 
     @abstractmethod
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality: ...

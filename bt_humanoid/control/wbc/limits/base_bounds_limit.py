@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.limits.base import FREE, Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.maths import concat, stack_rows, where
 
 NEAR = 0.3  # m beyond the radius from which a wall is considered at all
 
@@ -20,16 +21,13 @@ class BaseBoundsLimit(Limit):
         self.gain = gain
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
-        centre = kinematics.pose(self.base_frame).translation[:2]
-        jacobian = kinematics.jacobian(self.base_frame)[:2]
+        centre = kinematics.position(self.base_frame)[:2]
+        jacobian = kinematics.jacobian(self.base_frame)[:2, :]
         rows, lower = [], []
         for axis in (0, 1):
             for sign, wall in ((1.0, self.bounds[0, axis]), (-1.0, self.bounds[1, axis])):
                 distance = sign * (centre[axis] - wall)  # from the wall, inwards
-                if distance > self.radius + NEAR:
-                    continue
-                rows.append(sign * jacobian[axis])
-                lower.append(gap_bound(self.gain, self.radius - distance, dt))
-        if not rows:
-            return Inequality.none(len(kinematics.joints))
-        return Inequality(np.array(rows), np.array(lower))
+                rows.append(sign * jacobian[axis, :])
+                bound = gap_bound(self.gain, self.radius - distance, dt)
+                lower.append(where(distance > self.radius + NEAR, FREE, bound))  # a far wall is not considered
+        return Inequality(stack_rows(rows, len(kinematics.joints)), concat(lower))

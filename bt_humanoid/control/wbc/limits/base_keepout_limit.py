@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.limits.base import FREE, Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.maths import all_of, along, concat, maximum, minimum, norm, stack_rows, where
 
 
 class BaseKeepoutLimit(Limit):
@@ -18,12 +19,12 @@ class BaseKeepoutLimit(Limit):
         self.gain = gain
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
-        centre = kinematics.pose(self.base_frame).translation[:2]
-        closest = np.clip(centre, self.region[0], self.region[1])
+        centre = kinematics.position(self.base_frame)[:2]
+        closest = minimum(maximum(centre, self.region[0]), self.region[1])
         offset = centre - closest
-        distance = float(np.linalg.norm(offset))
-        if distance < 1e-6 or distance > self.radius + 0.3:
-            return Inequality.none(len(kinematics.joints))
-        normal = offset / distance
-        row = normal @ kinematics.jacobian(self.base_frame)[:2]
-        return Inequality(row[None, :], np.array([gap_bound(self.gain, self.radius - distance, dt)]))
+        distance = norm(offset)
+        row = along(offset / maximum(distance, 1e-6), kinematics.jacobian(self.base_frame)[:2, :])
+        # inside the box (no direction out) or farther than 0.3 m beyond the radius: the row is left free
+        near = all_of(distance >= 1e-6, distance <= self.radius + 0.3)
+        lower = where(near, gap_bound(self.gain, self.radius - distance, dt), FREE)
+        return Inequality(stack_rows([row], len(kinematics.joints)), concat([lower]))

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.limits.base import FREE, Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.maths import Value, all_of, concat, where
 
 
 class ClearanceLimit(Limit):
@@ -21,14 +22,12 @@ class ClearanceLimit(Limit):
         self.region = np.asarray(region, dtype=float)
         self.gain = gain
 
-    def covers(self, xy: np.ndarray) -> bool:
+    def covers(self, xy: Value) -> Value:
         """Whether the limit holds at ``xy`` (world x, y)."""
         (x0, y0), (x1, y1) = self.region
-        return bool(x0 <= xy[0] <= x1 and y0 <= xy[1] <= y1)
+        return all_of(x0 <= xy[0], xy[0] <= x1, y0 <= xy[1], xy[1] <= y1)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
-        position = kinematics.pose(self.frame).translation
-        if not self.covers(position):
-            return Inequality.none(len(kinematics.joints))
-        row = kinematics.jacobian(self.frame)[2:3]
-        return Inequality(row, np.array([gap_bound(self.gain, self.height - position[2], dt)]))
+        position = kinematics.position(self.frame)
+        lower = where(self.covers(position), gap_bound(self.gain, self.height - position[2], dt), FREE)
+        return Inequality(kinematics.jacobian(self.frame)[2:3, :], concat([lower]))

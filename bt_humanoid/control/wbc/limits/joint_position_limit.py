@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.maths import Value, maximum, minimum
 
 
 class JointPositionLimit:
@@ -15,9 +16,9 @@ class JointPositionLimit:
         self.upper = upper - margin
         self.gain = gain
 
-    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[Value, Value]:
         q = kinematics.positions
         # already outside (e.g. started there): allow no motion further out, any motion back in
-        low = np.minimum(self.gain * (self.lower - q), 0.0)
-        high = np.maximum(self.gain * (self.upper - q), 0.0)
+        low = minimum(self.gain * (self.lower - q), 0.0)
+        high = maximum(self.gain * (self.upper - q), 0.0)
         return low, high

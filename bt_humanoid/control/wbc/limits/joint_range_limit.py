@@ -6,6 +6,7 @@ import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
 from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.maths import concat, stack_rows
 
 
 class JointRangeLimit(Limit):
@@ -26,12 +27,12 @@ class JointRangeLimit(Limit):
             if joint not in kinematics.joints:
                 continue
             i = kinematics.joints.index(joint)
-            q = float(kinematics.positions[i])
+            q = kinematics.positions[i]
             for sign, distance in ((1.0, q - low), (-1.0, high - q)):  # each distance to a bound stays ≥ 0
-                row = np.zeros(n)
-                row[i] = sign
+                row = np.zeros((1, n))
+                row[0, i] = sign
                 rows.append(row)
                 lower.append(gap_bound(self.gain, -distance, dt))
         if not rows:
             return Inequality.none(n)
-        return Inequality(np.array(rows), np.array(lower))
+        return Inequality(stack_rows(rows, n), concat(lower))

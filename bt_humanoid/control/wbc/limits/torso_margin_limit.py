@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
-
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
-from bt_humanoid.control.wbc.limits.base import Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.limits.base import FREE, Inequality, Limit, gap_bound
+from bt_humanoid.control.wbc.maths import along, concat, maximum, norm, stack_rows, where
 
 
 class TorsoMarginLimit(Limit):
@@ -23,16 +20,13 @@ class TorsoMarginLimit(Limit):
         self.gain = gain
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
-        torso = kinematics.pose(self.torso).translation
-        torso_jac = kinematics.jacobian(self.torso)[:2]
+        torso = kinematics.position(self.torso)[:2]
+        torso_jacobian = kinematics.jacobian(self.torso)[:2, :]
         rows, lower = [], []
         for frame, margin in self.margins.items():
-            offset = kinematics.pose(frame).translation[:2] - torso[:2]  # horizontal
-            distance = math.hypot(offset[0], offset[1])
-            if distance < 1e-6:
-                continue
-            rows.append((offset / distance) @ (kinematics.jacobian(frame)[:2] - torso_jac))
-            lower.append(gap_bound(self.gain, margin - distance, dt))
-        if not rows:
-            return Inequality.none(len(kinematics.joints))
-        return Inequality(np.array(rows), np.array(lower))
+            offset = kinematics.position(frame)[:2] - torso  # horizontal
+            distance = norm(offset)
+            rows.append(along(offset / maximum(distance, 1e-6), kinematics.jacobian(frame)[:2, :] - torso_jacobian))
+            # a frame on the axis has no direction to be pushed away in: its row is left free
+            lower.append(where(distance > 1e-6, gap_bound(self.gain, margin - distance, dt), FREE))
+        return Inequality(stack_rows(rows, len(kinematics.joints)), concat(lower))

@@ -7,6 +7,7 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.maths import Value, concat, scale_rows, stack_rows
 
 
 class Task(ABC):
@@ -15,33 +16,44 @@ class Task(ABC):
     ``error`` is target minus current, so a step of ``Δq`` with ``J Δq = e``
     would close the gap in one control step; ``gain`` (0, 1] closes a fraction
     of it per step, which keeps motion smooth.
+
+    Both are written with ``maths``' operations, so they work on a
+    ``RobotKinematics`` (numbers) and on a ``SymbolicKinematics`` (CasADi
+    symbols, from which the whole-body controller compiles its QP once per
+    goal). A target that moves during a goal is read through
+    ``kinematics.parameter``.
     """
 
     def __init__(self, weight: float | np.ndarray = 1.0, gain: float = 1.0) -> None:
         self.weight = weight
         self.gain = gain
+        # the weight per row, built once and reused by the control loop while ``weight`` stays the same object
+        self._row_weights: tuple[object, np.ndarray] | None = None
 
     @abstractmethod
-    def error(self, kinematics: RobotKinematics) -> np.ndarray: ...
+    def error(self, kinematics: RobotKinematics) -> Value: ...
 
     @abstractmethod
-    def jacobian(self, kinematics: RobotKinematics) -> np.ndarray: ...
+    def jacobian(self, kinematics: RobotKinematics) -> Value: ...
 
-    def residual(self, kinematics: RobotKinematics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def residual(self, kinematics: RobotKinematics) -> tuple[Value, Value, np.ndarray]:
         """(J, gain · e, per-row weight): the rows this task adds to the stacked least-squares problem."""
         err = self.gain * self.error(kinematics)
-        weight = self.weight if isinstance(self.weight, np.ndarray) else np.full(len(err), float(self.weight))
-        return self.jacobian(kinematics), err, weight
+        weight, size = self.weight, err.shape[0]
+        if self._row_weights is None or self._row_weights[0] is not weight or len(self._row_weights[1]) != size:
+            rows = weight if isinstance(weight, np.ndarray) else np.full(size, float(weight))
+            self._row_weights = (weight, rows)
+        return self.jacobian(kinematics), err, self._row_weights[1]
 
-    def objective(self, kinematics: RobotKinematics) -> tuple[np.ndarray, np.ndarray]:
+    def objective(self, kinematics: RobotKinematics) -> tuple[Value, Value]:
         """(H, g) of this task's quadratic cost ½ Δqᵀ H Δq + gᵀ Δq."""
         return stacked_objective([self.residual(kinematics)])
 
 
-def stacked_objective(residuals: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+def stacked_objective(residuals: list[tuple[Value, Value, np.ndarray]]) -> tuple[Value, Value]:
     """(H, g) of the sum of several tasks' costs, from their rows stacked into one Jacobian: two matrix products
     for all of them rather than two each."""
-    jac = np.vstack([r[0] for r in residuals])
-    err = np.concatenate([r[1] for r in residuals])
-    weighted = jac * np.concatenate([r[2] for r in residuals])[:, None]
+    jac = stack_rows([r[0] for r in residuals], 0)
+    err = concat([r[1] for r in residuals])
+    weighted = scale_rows(jac, np.concatenate([r[2] for r in residuals]))
     return jac.T @ weighted, -weighted.T @ err

@@ -6,6 +6,7 @@ import numpy as np
 import pinocchio as pin
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.maths import Value, concat, log3
 from bt_humanoid.control.wbc.tasks.base import Task
 
 
@@ -24,12 +25,14 @@ class FrameTask(Task):
         self.frame = frame
         self.target = target
 
-    def error(self, kinematics: RobotKinematics) -> np.ndarray:
-        current = kinematics.pose(self.frame)
-        position = self.target.translation - current.translation
+    def error(self, kinematics: RobotKinematics) -> Value:
+        # the target moves along the reach every control step
+        target_position = kinematics.parameter(lambda: self.target.translation, (3, 1))
+        target_rotation = kinematics.parameter(lambda: self.target.rotation, (3, 3))
+        position = target_position - kinematics.position(self.frame)
         # rotation that takes the current orientation to the target, as a world-frame rotation vector
-        orientation = pin.log3(self.target.rotation @ current.rotation.T)
-        return np.concatenate([position, orientation])
+        orientation = log3(target_rotation @ kinematics.rotation(self.frame).T)
+        return concat([position, orientation])
 
-    def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
+    def jacobian(self, kinematics: RobotKinematics) -> Value:
         return kinematics.jacobian(self.frame)

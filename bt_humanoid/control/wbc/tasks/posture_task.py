@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.maths import Value
 from bt_humanoid.control.wbc.tasks.base import Task
 
 
@@ -15,16 +16,19 @@ class PostureTask(Task):
         super().__init__(weight, gain)
         self.posture = posture
         self.target = np.array(list(posture.values()), dtype=float)
-        self._selection: np.ndarray | None = None  # constant: built on first use, the control loop reuses it
+        # constant: built on first use, the control loop reuses them
+        self._columns: np.ndarray | None = None  # the posture's joints among the controlled ones
+        self._selection: np.ndarray | None = None  # its Jacobian: one row per joint, a 1 in that joint's column
 
     def _select(self, kinematics: RobotKinematics) -> np.ndarray:
-        if self._selection is None:
-            rows = [kinematics.index(joint) for joint in self.posture]
-            self._selection = np.eye(len(kinematics.joints))[rows]
-        return self._selection
+        if self._columns is None:
+            self._columns = np.array([kinematics.index(joint) for joint in self.posture], dtype=int)
+            self._selection = np.eye(len(kinematics.joints))[self._columns]
+        return self._columns
 
-    def error(self, kinematics: RobotKinematics) -> np.ndarray:
-        return self.target - self._select(kinematics) @ kinematics.positions
+    def error(self, kinematics: RobotKinematics) -> Value:
+        return self.target - kinematics.positions[self._select(kinematics)]
 
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
-        return self._select(kinematics)
+        self._select(kinematics)
+        return self._selection
