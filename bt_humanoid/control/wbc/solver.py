@@ -1,4 +1,4 @@
-"""Build and solve the whole-body QP: one function, tasks in the cost, limits as constraints.
+"""Build and solve the whole-body QP: tasks in the cost, limits as constraints.
 
     minimise   Σ_tasks ½‖J_i Δq − k_i e_i‖²_{W_i} + ½ λ‖Δq‖²
     subject to lb ≤ Δq ≤ ub          (joint position and velocity limits)
@@ -6,7 +6,8 @@
 
 solved with a CasADi conic solver (DAQP by default: dense active-set, exact,
 fastest of those CasADi offers for this size), built once per problem shape
-and reused, fed through a buffer (``conic.py``).
+and reused, fed through a buffer (``conic.py``). ``qp_terms`` builds the terms from numbers or from symbols;
+``solve_ik`` solves them from numbers, ``CompiledQp`` (``compiled.py``) from a function compiled once per goal.
 """
 
 from __future__ import annotations
