@@ -1,6 +1,6 @@
 """The robot's forward kinematics as CasADi expressions, built from its Pinocchio model.
 
-Pinocchio's own CasADi bindings are not in the PyPI wheels (NOTES.md), so
+Pinocchio's own CasADi bindings (pinocchio.casadi) are not in the PyPI wheels, so
 the chain is written out here from the model Pinocchio reads from the MJCF:
 each joint's placement in its parent, then its motion (a rotation about, or a
 slide along, its axis; a planar base is Pinocchio's composite of x, y and yaw;
