@@ -5,7 +5,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from bt_humanoid.control.wbc.compiled import CompiledQp
+from bt_humanoid.control.wbc.compiled import CompiledQp, CompiledQps, compile_qp
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
 from bt_humanoid.control.wbc.limits import (
     BaseBoundsLimit,
@@ -73,32 +73,40 @@ def test_symbolic_log3_matches_pinocchio_up_to_nearly_a_half_turn():
         assert np.allclose(np.array(evaluate(R)).ravel(), pin.log3(R), atol=1e-6), angle
 
 
+def _reach_goal(config, numeric, offset: float):
+    """A reach with every kind of task and limit; ``offset`` moves every target and outline (the same signature)."""
+    n = len(numeric.joints)
+    numeric.update(np.zeros(n))
+    grip = config.grippers["right"].grip_site
+    target = numeric.pose(grip).copy()
+    target.translation += offset
+    tasks = [
+        FrameTask(grip, target, gain=0.6),
+        PostureTask({j: 0.1 + offset for j in config.groups["left_arm"]}, 1.0, 0.5),
+        GazeTask(config.frames["head_camera"][1], np.array([1.0, 0.2, 0.8]) + offset),
+        DampingTask(config.base.planar_joints, 1.0),
+    ]
+    box = [JointPositionLimit(np.full(n, -2.5), np.full(n, 2.5)), VelocityLimit(np.full(n, 1.0 + offset))]
+    limits = [
+        TorsoMarginLimit(config.frames["torso"][1], {g.grip_site: 0.2 for g in config.grippers.values()}),
+        BaseKeepoutLimit("base", np.array([[0.5, -0.5], [1.5, 0.5]]) + offset, 0.4),
+        BaseBoundsLimit("base", np.array([[-1.0, -1.0], [1.0, 1.0]]) + offset, 0.4),
+        ClearanceLimit(grip, 0.8 + offset, np.array([[0.2, -0.5], [1.0, 0.5]]) + offset),
+        JointRangeLimit({config.groups["right_arm"][-1]: (-0.5, 0.5)}),
+    ]
+    return tasks, box, limits
+
+
 @pytest.fixture(scope="module")
 def reach():
     """A reach with every kind of task and limit, on the wheeled robot."""
     config = load_robot_config("wheeled_humanoid")
-    joints = _controlled(config)
-    n = len(joints)
-    numeric = RobotKinematics(config, joints)
-    numeric.update(np.zeros(n))
-    grip = config.grippers["right"].grip_site
-    frame_task = FrameTask(grip, numeric.pose(grip).copy(), gain=0.6)
-    tasks = [
-        frame_task,
-        PostureTask({j: 0.1 for j in config.groups["left_arm"]}, 1.0, 0.5),
-        GazeTask(config.frames["head_camera"][1], np.array([1.0, 0.2, 0.8])),
-        DampingTask(config.base.planar_joints, 1.0),
-    ]
-    box = [JointPositionLimit(np.full(n, -2.5), np.full(n, 2.5)), VelocityLimit(np.full(n, 1.0))]
-    limits = [
-        TorsoMarginLimit(config.frames["torso"][1], {g.grip_site: 0.2 for g in config.grippers.values()}),
-        BaseKeepoutLimit("base", np.array([[0.5, -0.5], [1.5, 0.5]]), 0.4),
-        BaseBoundsLimit("base", np.array([[-1.0, -1.0], [1.0, 1.0]]), 0.4),
-        ClearanceLimit(grip, 0.8, np.array([[0.2, -0.5], [1.0, 0.5]])),
-        JointRangeLimit({config.groups["right_arm"][-1]: (-0.5, 0.5)}),
-    ]
-    compiled = CompiledQp(SymbolicKinematics(config, joints), tasks, box, limits, DT)
-    return numeric, frame_task, tasks, box, limits, compiled
+    numeric = RobotKinematics(config, _controlled(config))
+    tasks, box, limits = _reach_goal(config, numeric, 0.0)
+    function, parameters = compile_qp(SymbolicKinematics(config, numeric.joints), tasks, box, limits, DT)
+    compiled = CompiledQp(function)
+    compiled.bind(parameters)
+    return numeric, tasks[0], tasks, box, limits, compiled
 
 
 def test_compiled_qp_equals_the_qp_built_from_numbers(reach):
@@ -145,7 +153,36 @@ def test_an_infeasible_compiled_qp_is_reported_and_gives_no_step(reach):
     numeric.update(np.zeros(n))
     x, y, z = numeric.position(grip)
     over = ClearanceLimit(grip, z + 0.5, np.array([[x - 0.1, y - 0.1], [x + 0.1, y + 0.1]]))
-    qp = CompiledQp(SymbolicKinematics(config, numeric.joints), tasks, stuck, [over], DT)
+    function, parameters = compile_qp(SymbolicKinematics(config, numeric.joints), tasks, stuck, [over], DT)
+    qp = CompiledQp(function)
+    qp.bind(parameters)
     solution = qp.solve(np.zeros(n), numeric.q)
     assert not solution.solved
     assert np.array_equal(solution.step, np.zeros(n))
+
+
+def test_a_goal_like_an_earlier_one_reuses_its_compiled_qp_with_its_own_numbers():
+    config = load_robot_config("wheeled_humanoid")
+    numeric = RobotKinematics(config, _controlled(config))
+    symbolic = SymbolicKinematics(config, numeric.joints)
+    dt = 0.0123  # a control period no other test compiles for: the process's compiled QPs start empty for it
+    qps = CompiledQps(symbolic, numeric, dt)
+    first = qps.for_goal(*_reach_goal(config, numeric, 0.0))
+    tasks, box, limits = _reach_goal(config, numeric, 0.05)  # new targets, outlines and speeds
+    second = qps.for_goal(tasks, box, limits)
+    assert second is first and len(qps.compile_times) == 1 and len(qps.bind_times) == 1
+    # another controller in the process reuses the compiled function, with buffers of its own
+    other = CompiledQps(symbolic, RobotKinematics(config, numeric.joints), dt)
+    third = other.for_goal(*_reach_goal(config, numeric, 0.1))
+    assert third is not second and not other.compile_times and len(other.bind_times) == 1
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        positions = rng.uniform(-1.0, 1.0, len(numeric.joints))
+        numeric.update(positions)
+        expected = solve_ik(numeric, tasks, box, limits, dt)
+        got = second.solve(positions, numeric.q)
+        assert got.solved == expected.solved
+        assert np.allclose(got.step, expected.step, atol=1e-9)
+    # another kind of goal (no gaze) is compiled for itself
+    qps.for_goal(tasks[:2], box, limits)
+    assert len(qps.compile_times) == 2

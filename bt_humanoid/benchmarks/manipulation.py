@@ -79,7 +79,8 @@ class Outcome:
     fell: bool
     qp_times: list[float]
     conic_times: list[float]
-    compile_times: list[float]  # s compiling each goal's QP, once per goal
+    compile_times: list[float]  # s compiling each kind of goal's QP
+    bind_times: list[float]  # s binding a QP compiled before to a goal like it
 
 
 def _edge_frame(surface: SupportSurface, edge: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -201,7 +202,8 @@ def run_trial(trial: Trial, perception: str = "camera", robot: str = "wheeled_hu
         fell=fell,
         qp_times=list(run.robot.whole_body.solve_times),
         conic_times=list(run.robot.whole_body.conic_times),
-        compile_times=list(run.robot.whole_body.compile_times),
+        compile_times=list(run.robot.whole_body.qps.compile_times),
+        bind_times=list(run.robot.whole_body.qps.bind_times),
     )
 
 
@@ -264,7 +266,7 @@ def main(argv: list[str] | None = None) -> int:
         f"perception {args.perception} (one core)"
     )
     started, cpu_started = time.perf_counter(), time.process_time()
-    summaries, qp_times, conic_times, compile_times = [], [], [], []
+    summaries, qp_times, conic_times, compile_times, bind_times = [], [], [], [], []
     for kind in args.kinds:
         trials = [sample_trial(kind, surface, bounds, base, rng) for _ in range(args.trials)]
         outcomes = []
@@ -274,6 +276,7 @@ def main(argv: list[str] | None = None) -> int:
             qp_times.extend(outcome.qp_times)
             conic_times.extend(outcome.conic_times)
             compile_times.extend(outcome.compile_times)
+            bind_times.extend(outcome.bind_times)
             verdict = "ok" if outcome.placed else f"FAILED: {outcome.failure}"
             where = f"{trial.edge} edge, spot ({trial.spot[0]:.2f}, {trial.spot[1]:.2f}), yaw {trial.yaw:+.2f}"
             print(f"  {kind} {i}/{len(trials)}  {where}: {verdict}", flush=True)
@@ -292,6 +295,9 @@ def main(argv: list[str] | None = None) -> int:
         "qp_compiles": len(compile_times),
         "qp_compile_median_ms": statistics.median(compile_times) * 1000 if compile_times else 0.0,
         "qp_compile_total_s": round(sum(compile_times), 2),
+        "qp_binds": len(bind_times),
+        "qp_bind_median_ms": statistics.median(bind_times) * 1000 if bind_times else 0.0,
+        "qp_bind_total_s": round(sum(bind_times), 2),
         "wall_s": round(time.perf_counter() - started, 1),
         "cpu_s": round(time.process_time() - cpu_started, 1),
         "falls": sum(s["falls"] for s in summaries),
@@ -307,8 +313,9 @@ def main(argv: list[str] | None = None) -> int:
         f"of it in the conic solver: median {figures['conic_median_ms']:.3f} ms"
     )
     print(
-        f"  compiling each goal's QP: median {figures['qp_compile_median_ms']:.1f} ms over {figures['qp_compiles']} "
-        f"goals, {figures['qp_compile_total_s']:.1f} s in all"
+        f"  QPs compiled: {figures['qp_compiles']} (median {figures['qp_compile_median_ms']:.1f} ms, "
+        f"{figures['qp_compile_total_s']:.1f} s in all); goals that reused one: {figures['qp_binds']} "
+        f"(median {figures['qp_bind_median_ms']:.2f} ms, {figures['qp_bind_total_s']:.1f} s in all)"
     )
     print(f"  falls: {figures['falls']} (target 0)")
     print(

@@ -17,7 +17,6 @@ robot steps to where it works (stance planning); its hands do not pull it there.
 from __future__ import annotations
 
 import math
-import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,10 +29,10 @@ from bt_humanoid.control.base_motion import BaseMotion
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.motion import MotionHandle, plan_trajectory
 from bt_humanoid.control.wbc import RobotKinematics
-from bt_humanoid.control.wbc.compiled import CompiledQp
+from bt_humanoid.control.wbc.compiled import CompiledQp, CompiledQps
 from bt_humanoid.control.wbc.limits import JointPositionLimit, Limit, TorsoMarginLimit, VelocityLimit
 from bt_humanoid.control.wbc.solver import BoxLimit
-from bt_humanoid.control.wbc.symbolic_kinematics import SymbolicKinematics
+from bt_humanoid.control.wbc.symbolic_kinematics import symbolic_kinematics
 from bt_humanoid.control.wbc.tasks import DampingTask, FrameTask, GazeTask, PostureTask, Task
 from bt_humanoid.sim.robot_config import RobotConfig
 
@@ -104,7 +103,6 @@ class WholeBodyController:
         self.names = self.base_joints + body_joints
         self.kinematics = RobotKinematics(config, self.names)  # at the reference configuration
         self.measured = RobotKinematics(config, self.names)  # at the encoder readings
-        self.symbolic = SymbolicKinematics(config, self.names)  # each goal's QP is compiled from it
         self._body_index = joints.indices(body_joints)
         lower = np.array([joint_ranges.get(j, (-np.inf, np.inf))[0] for j in self.names])
         upper = np.array([joint_ranges.get(j, (-np.inf, np.inf))[1] for j in self.names])
@@ -123,8 +121,9 @@ class WholeBodyController:
         self.base_target = np.zeros(3)  # pose the base holds during and after a whole-body goal
         self.solve_times: deque[float] = deque(maxlen=100_000)  # wall seconds per QP, for benchmarks
         self.conic_times: deque[float] = deque(maxlen=100_000)  # of which in the conic solver
-        self.compile_times: deque[float] = deque(maxlen=10_000)  # wall seconds compiling each goal's QP
         self.dt = 0.01
+        # each kind of goal's QP is compiled once per process, from the kinematics in symbols
+        self.qps = CompiledQps(symbolic_kinematics(config, self.names), self.kinematics, self.dt)
 
     # ------------------------------------------------------------------ queries
 
@@ -253,9 +252,8 @@ class WholeBodyController:
         self.reference[:base] = self._base_pose()
         self._update(self.kinematics, self.reference)
         if goal.qp is None:
-            compiling = time.perf_counter()
-            goal.qp = CompiledQp(self.symbolic, goal.tasks, goal.box_limits, goal.limits, self.dt)
-            self.compile_times.append(time.perf_counter() - compiling)
+            self.qps.dt = self.dt
+            goal.qp = self.qps.for_goal(goal.tasks, goal.box_limits, goal.limits)
         solution = goal.qp.solve(self.reference, self.kinematics.q)
         self.solve_times.append(solution.solve_time)
         self.conic_times.append(solution.conic_time)

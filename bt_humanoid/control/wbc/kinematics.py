@@ -9,8 +9,11 @@ controlled joint, in that order.
 from __future__ import annotations
 
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -82,7 +85,36 @@ def controlled_indices(model: pin.Model, config: RobotConfig, joints: list[str])
     return np.array(q_index, dtype=int), np.array(v_index, dtype=int)
 
 
-class RobotKinematics:
+@dataclass
+class Parameter:
+    """A number a task or limit reads through ``kinematics.parameter``: what differs between goals of one
+    signature (a posture's targets, a table's outline), or moves during one (a reach's target)."""
+
+    read: Callable[[], np.ndarray]
+    shape: tuple[int, int]
+    moving: bool  # read every control step, not once when the goal starts
+    symbol: Any = None  # its CasADi symbol, where the QP is built in symbols
+
+
+class RecordsParameters:
+    """Lists the parameters tasks and limits ask for while one QP is built."""
+
+    _recording: list[Parameter] | None = None
+
+    @contextmanager
+    def recording_parameters(self) -> Iterator[list[Parameter]]:
+        self._recording = []
+        try:
+            yield self._recording
+        finally:
+            self._recording = None
+
+    def _record(self, parameter: Parameter) -> None:
+        if self._recording is not None:
+            self._recording.append(parameter)
+
+
+class RobotKinematics(RecordsParameters):
     """Forward kinematics and frame Jacobians over the controlled joints."""
 
     def __init__(self, config: RobotConfig, joints: list[str]) -> None:
@@ -102,9 +134,10 @@ class RobotKinematics:
     def index(self, joint: str) -> int:
         return self.joints.index(joint)
 
-    def parameter(self, read: Callable[[], np.ndarray], shape: tuple[int, int]) -> np.ndarray:
-        """A number a task reads that may change during a goal (a moving target): here, its value now. (A
+    def parameter(self, read: Callable[[], np.ndarray], shape: tuple[int, int], moving: bool = False) -> np.ndarray:
+        """A number a task or limit reads that is not fixed by its signature: here, its value now. (A
         ``SymbolicKinematics`` makes it an input of the compiled QP instead.)"""
+        self._record(Parameter(read, shape, moving))
         return np.asarray(read(), dtype=float)
 
     def update(self, positions: np.ndarray) -> None:

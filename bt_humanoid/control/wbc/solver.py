@@ -28,6 +28,8 @@ from bt_humanoid.control.wbc.tasks.base import Task, stacked_objective
 class BoxLimit(Protocol):
     def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[Value, Value]: ...
 
+    def signature(self) -> tuple: ...
+
 
 @dataclass
 class Solution:

@@ -16,15 +16,20 @@ code builds the QP in symbols once per goal (``compiled.py``).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 import pinocchio as pin
 
-from bt_humanoid.control.wbc.kinematics import cached_frame_id, controlled_indices, robot_model
+from bt_humanoid.control.wbc.kinematics import (
+    Parameter,
+    RecordsParameters,
+    cached_frame_id,
+    controlled_indices,
+    robot_model,
+)
 from bt_humanoid.sim.robot_config import RobotConfig
 
 _AXES = {"X": np.array([1.0, 0.0, 0.0]), "Y": np.array([0.0, 1.0, 0.0]), "Z": np.array([0.0, 0.0, 1.0])}
@@ -40,7 +45,7 @@ class _Axis:
     origin: ca.SX  # a point on the axis, world
 
 
-class SymbolicKinematics:
+class SymbolicKinematics(RecordsParameters):
     """Frame poses and Jacobians of the controlled joints, as CasADi SX expressions of the configuration.
 
     ``controlled`` (the controlled joints' positions, in ``joints`` order) and
@@ -50,6 +55,7 @@ class SymbolicKinematics:
 
     def __init__(self, config: RobotConfig, joints: list[str]) -> None:
         self.model = robot_model(config)
+        self.robot = str(config.folder)  # which robot: compiled QPs are kept per robot
         self.joints = list(joints)
         self._q_index, _ = controlled_indices(self.model, config, self.joints)
         self.controlled = ca.SX.sym("controlled", len(self.joints))
@@ -71,28 +77,18 @@ class SymbolicKinematics:
         self._frame_ids: dict[str, int] = {}
         self._frames: dict[str, tuple[ca.SX, ca.SX, int]] = {}  # built once each: one graph node per quantity
         self._jacobians: dict[str, ca.SX] = {}
-        self._recording: list[tuple[ca.SX, Callable[[], np.ndarray]]] | None = None
 
     def index(self, joint: str) -> int:
         return self.joints.index(joint)
 
-    def parameter(self, read: Callable[[], np.ndarray], shape: tuple[int, int]) -> ca.SX:
-        """A number that may change during a goal (a moving target) as a new symbol; the compiled QP calls
-        ``read`` each step for its value."""
-        symbol = ca.SX.sym(f"p{len(self._recording or [])}", *shape)
+    def parameter(self, read: Callable[[], np.ndarray], shape: tuple[int, int], moving: bool = False) -> ca.SX:
+        """A number that is not fixed by a task's or limit's signature, as a new symbol: the compiled QP's
+        input, fed from ``read`` when a goal starts (and every step if ``moving``)."""
         if self._recording is None:
             raise RuntimeError("a parameter outside recording_parameters(): nothing would feed it")
-        self._recording.append((symbol, read))
+        symbol = ca.SX.sym(f"p{len(self._recording)}", *shape)
+        self._record(Parameter(read, shape, moving, symbol))
         return symbol
-
-    @contextmanager
-    def recording_parameters(self) -> Iterator[list[tuple[ca.SX, Callable[[], np.ndarray]]]]:
-        """Collect the parameters that tasks and limits ask for while one QP is built."""
-        self._recording = []
-        try:
-            yield self._recording
-        finally:
-            self._recording = None
 
     def frame_id(self, frame: str) -> int:
         return cached_frame_id(self.model, self._frame_ids, frame)
@@ -177,3 +173,14 @@ class SymbolicKinematics:
 def _compose(rotation: ca.SX, translation: ca.SX, placement: pin.SE3) -> tuple[ca.SX, ca.SX]:
     """(R, p) ∘ placement."""
     return rotation @ ca.SX(placement.rotation), translation + rotation @ ca.SX(placement.translation)
+
+
+_built: dict[tuple[str, tuple[str, ...]], SymbolicKinematics] = {}
+
+
+def symbolic_kinematics(config: RobotConfig, joints: list[str]) -> SymbolicKinematics:
+    """The process's symbolic kinematics of a robot over these joints, built once (a few tens of ms)."""
+    key = (str(config.folder), tuple(joints))
+    if key not in _built:
+        _built[key] = SymbolicKinematics(config, joints)
+    return _built[key]

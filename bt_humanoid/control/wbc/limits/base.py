@@ -50,3 +50,8 @@ class Limit(ABC):
 
     @abstractmethod
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality: ...
+
+    @abstractmethod
+    def signature(self) -> tuple:
+        """What a compiled QP fixes of this limit (its frames, gains); the rest it reads through
+        ``kinematics.parameter``."""

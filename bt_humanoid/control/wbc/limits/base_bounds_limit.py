@@ -20,12 +20,16 @@ class BaseBoundsLimit(Limit):
         self.radius = radius
         self.gain = gain
 
+    def signature(self) -> tuple:
+        return ("BaseBoundsLimit", self.base_frame, self.radius, self.gain)
+
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         centre = kinematics.position(self.base_frame)[:2]
         jacobian = kinematics.jacobian(self.base_frame)[:2, :]
+        bounds = kinematics.parameter(lambda: self.bounds, (2, 2))  # the map's walls
         rows, lower = [], []
         for axis in (0, 1):
-            for sign, wall in ((1.0, self.bounds[0, axis]), (-1.0, self.bounds[1, axis])):
+            for sign, wall in ((1.0, bounds[0, axis]), (-1.0, bounds[1, axis])):
                 distance = sign * (centre[axis] - wall)  # from the wall, inwards
                 rows.append(sign * jacobian[axis, :])
                 bound = gap_bound(self.gain, self.radius - distance, dt)

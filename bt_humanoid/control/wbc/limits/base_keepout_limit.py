@@ -18,9 +18,13 @@ class BaseKeepoutLimit(Limit):
         self.radius = radius
         self.gain = gain
 
+    def signature(self) -> tuple:
+        return ("BaseKeepoutLimit", self.base_frame, self.radius, self.gain)
+
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         centre = kinematics.position(self.base_frame)[:2]
-        closest = minimum(maximum(centre, self.region[0]), self.region[1])
+        region = kinematics.parameter(lambda: self.region, (2, 2))  # the table's outline
+        closest = minimum(maximum(centre, region[0, :].T), region[1, :].T)
         offset = centre - closest
         distance = norm(offset)
         row = along(offset / maximum(distance, 1e-6), kinematics.jacobian(self.base_frame)[:2, :])

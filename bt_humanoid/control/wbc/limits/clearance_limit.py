@@ -22,12 +22,21 @@ class ClearanceLimit(Limit):
         self.region = np.asarray(region, dtype=float)
         self.gain = gain
 
-    def covers(self, xy: Value) -> Value:
+    def covers(self, xy: np.ndarray) -> bool:
         """Whether the limit holds at ``xy`` (world x, y)."""
-        (x0, y0), (x1, y1) = self.region
-        return all_of(x0 <= xy[0], xy[0] <= x1, y0 <= xy[1], xy[1] <= y1)
+        return bool(_within(self.region, xy))
+
+    def signature(self) -> tuple:
+        return ("ClearanceLimit", self.frame, self.gain)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         position = kinematics.position(self.frame)
-        lower = where(self.covers(position), gap_bound(self.gain, self.height - position[2], dt), FREE)
+        region = kinematics.parameter(lambda: self.region, (2, 2))
+        height = kinematics.parameter(lambda: np.array([self.height]), (1, 1))[0]
+        lower = where(_within(region, position), gap_bound(self.gain, height - position[2], dt), FREE)
         return Inequality(kinematics.jacobian(self.frame)[2:3, :], concat([lower]))
+
+
+def _within(region: Value, xy: Value) -> Value:
+    """Whether ``xy`` lies in the rectangle ``region`` [[x0, y0], [x1, y1]]."""
+    return all_of(region[0, 0] <= xy[0], xy[0] <= region[1, 0], region[0, 1] <= xy[1], xy[1] <= region[1, 1])

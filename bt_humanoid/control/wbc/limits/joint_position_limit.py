@@ -16,9 +16,14 @@ class JointPositionLimit:
         self.upper = upper - margin
         self.gain = gain
 
+    def signature(self) -> tuple:
+        return ("JointPositionLimit", self.gain)
+
     def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[Value, Value]:
         q = kinematics.positions
+        lower = kinematics.parameter(lambda: self.lower, (len(self.lower), 1))
+        upper = kinematics.parameter(lambda: self.upper, (len(self.upper), 1))
         # already outside (e.g. started there): allow no motion further out, any motion back in
-        low = minimum(self.gain * (self.lower - q), 0.0)
-        high = maximum(self.gain * (self.upper - q), 0.0)
+        low = minimum(self.gain * (lower - q), 0.0)
+        high = maximum(self.gain * (upper - q), 0.0)
         return low, high

@@ -20,6 +20,9 @@ class JointRangeLimit(Limit):
         self.ranges = dict(ranges)
         self.gain = gain
 
+    def signature(self) -> tuple:
+        return ("JointRangeLimit", tuple(self.ranges.items()), self.gain)
+
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         n = len(kinematics.joints)
         rows, lower = [], []

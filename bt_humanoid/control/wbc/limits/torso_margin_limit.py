@@ -19,6 +19,9 @@ class TorsoMarginLimit(Limit):
         self.margins = margins  # frame → metres
         self.gain = gain
 
+    def signature(self) -> tuple:
+        return ("TorsoMarginLimit", self.torso, tuple(self.margins.items()), self.gain)
+
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         torso = kinematics.position(self.torso)[:2]
         torso_jacobian = kinematics.jacobian(self.torso)[:2, :]

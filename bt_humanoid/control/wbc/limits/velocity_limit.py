@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
+from bt_humanoid.control.wbc.maths import Value
 
 
 class VelocityLimit:
@@ -13,5 +14,9 @@ class VelocityLimit:
     def __init__(self, max_velocity: np.ndarray) -> None:
         self.max_velocity = np.asarray(max_velocity, dtype=float)
 
-    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        return -self.max_velocity * dt, self.max_velocity * dt
+    def signature(self) -> tuple:
+        return ("VelocityLimit",)
+
+    def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[Value, Value]:
+        speed = kinematics.parameter(lambda: self.max_velocity, (len(self.max_velocity), 1))  # frozen joints: 0
+        return -speed * dt, speed * dt

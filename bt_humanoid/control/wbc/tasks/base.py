@@ -45,6 +45,15 @@ class Task(ABC):
             self._row_weights = (weight, rows)
         return self.jacobian(kinematics), err, self._row_weights[1]
 
+    def signature(self) -> tuple:
+        """What a compiled QP fixes of this task: two tasks of one signature differ only in the numbers they
+        read through ``kinematics.parameter`` (a goal like an earlier one reuses its compiled QP)."""
+        return (type(self).__name__, tuple(np.atleast_1d(self.weight).tolist()), self.gain, *self._fixed())
+
+    def _fixed(self) -> tuple:
+        """The task's own part of its signature: its frames and joints."""
+        return ()
+
     def objective(self, kinematics: RobotKinematics) -> tuple[Value, Value]:
         """(H, g) of this task's quadratic cost ½ Δqᵀ H Δq + gᵀ Δq."""
         return stacked_objective([self.residual(kinematics)])

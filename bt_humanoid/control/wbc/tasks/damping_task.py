@@ -20,6 +20,9 @@ class DampingTask(Task):
     def error(self, kinematics: RobotKinematics) -> np.ndarray:
         return self._zero
 
+    def _fixed(self) -> tuple:
+        return tuple(self.joints)
+
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
         if self._selection is None:
             self._selection = np.eye(len(kinematics.joints))[[kinematics.index(j) for j in self.joints]]

@@ -27,12 +27,15 @@ class FrameTask(Task):
 
     def error(self, kinematics: RobotKinematics) -> Value:
         # the target moves along the reach every control step
-        target_position = kinematics.parameter(lambda: self.target.translation, (3, 1))
-        target_rotation = kinematics.parameter(lambda: self.target.rotation, (3, 3))
+        target_position = kinematics.parameter(lambda: self.target.translation, (3, 1), moving=True)
+        target_rotation = kinematics.parameter(lambda: self.target.rotation, (3, 3), moving=True)
         position = target_position - kinematics.position(self.frame)
         # rotation that takes the current orientation to the target, as a world-frame rotation vector
         orientation = log3(target_rotation @ kinematics.rotation(self.frame).T)
         return concat([position, orientation])
+
+    def _fixed(self) -> tuple:
+        return (self.frame,)
 
     def jacobian(self, kinematics: RobotKinematics) -> Value:
         return kinematics.jacobian(self.frame)

@@ -23,7 +23,7 @@ class GazeTask(Task):
 
     def _axes(self, kinematics: RobotKinematics) -> tuple[Value, Value]:
         axis = -kinematics.rotation(self.camera)[:, 2]
-        to_target = self.target - kinematics.position(self.camera)
+        to_target = kinematics.parameter(lambda: self.target, (3, 1)) - kinematics.position(self.camera)
         return axis, to_target / maximum(norm(to_target), 1e-6)
 
     def error(self, kinematics: RobotKinematics) -> Value:
@@ -34,6 +34,9 @@ class GazeTask(Task):
         """Angle (rad) between the optical axis and the direction to the target: 0 centred, π behind."""
         axis, direction = self._axes(kinematics)
         return float(np.arctan2(np.linalg.norm(cross(axis, direction)), axis @ direction))
+
+    def _fixed(self) -> tuple:
+        return (self.camera,)
 
     def jacobian(self, kinematics: RobotKinematics) -> Value:
         axis, _ = self._axes(kinematics)

@@ -27,7 +27,11 @@ class PostureTask(Task):
         return self._columns
 
     def error(self, kinematics: RobotKinematics) -> Value:
-        return self.target - kinematics.positions[self._select(kinematics)]
+        target = kinematics.parameter(lambda: self.target, (len(self.target), 1))
+        return target - kinematics.positions[self._select(kinematics)]
+
+    def _fixed(self) -> tuple:
+        return tuple(self.posture)
 
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
         self._select(kinematics)
