@@ -178,7 +178,10 @@ def test_a_bounds_limit_keeps_the_base_off_the_walls():
     jacobian = np.zeros((6, 3))
     jacobian[0, 0] = jacobian[1, 1] = 1.0  # the base's x and y joints move it straight
     kinematics = SimpleNamespace(
-        joints=["x", "y", "yaw"], position=lambda _: base.translation, jacobian=lambda _: jacobian
+        joints=["x", "y", "yaw"],
+        position=lambda _: base.translation,
+        jacobian=lambda _: jacobian,
+        parameter=lambda read, shape, moving=False: np.asarray(read()),  # numbers, as RobotKinematics gives them
     )
     limit = BaseBoundsLimit("base", np.array([[-1.5, -3.5], [7.5, 3.8]]), radius=0.35)
     near = limit.inequality(kinematics, 0.01)  # 0.4 m from the east wall: only it is near enough to count
