@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 import statistics
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -79,8 +79,8 @@ class Outcome:
     fell: bool
     qp_times: list[float]
     conic_times: list[float]
-    compile_times: list[float]  # s compiling each kind of goal's QP
-    bind_times: list[float]  # s binding a QP compiled before to a goal like it
+    compile_times: list[float] = field(default_factory=list)  # s compiling each kind of goal's QP
+    bind_times: list[float] = field(default_factory=list)  # s binding a QP compiled before to a goal like it
 
 
 def _edge_frame(surface: SupportSurface, edge: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
