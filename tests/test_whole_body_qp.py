@@ -5,7 +5,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from bt_humanoid.control.wbc.compiled import CompiledQp, CompiledQps, compile_qp
+from bt_humanoid.control.wbc.compiled import CompiledQp, QpCache, compile_qp
 from bt_humanoid.control.wbc.kinematics import RobotKinematics
 from bt_humanoid.control.wbc.limits import (
     BaseBoundsLimit,
@@ -126,7 +126,9 @@ def test_compiled_qp_equals_the_qp_built_from_numbers(reach):
         assert np.allclose(inputs["h"].reshape(n, n), terms.hessian, atol=1e-10)
         assert np.allclose(inputs["g"], terms.gradient, atol=1e-10)
         assert np.allclose(inputs["a"].reshape(n, -1).T, terms.constraints, atol=1e-10)
-        assert np.array_equal(np.isinf(inputs["lba"]), np.isinf(terms.constraints_lower))
+        for name, expected_bound in (("lba", terms.constraints_lower), ("lbx", terms.lower), ("ubx", terms.upper)):
+            # ±inf where no bound holds, in the same places (allclose counts equal infinities as close)
+            assert np.allclose(inputs[name], expected_bound, atol=1e-12), name
         assert got.solved == expected.solved
         assert np.allclose(got.step, expected.step, atol=1e-9)
         solved += got.solved
@@ -166,14 +168,14 @@ def test_a_goal_like_an_earlier_one_reuses_its_compiled_qp_with_its_own_numbers(
     numeric = RobotKinematics(config, _controlled(config))
     symbolic = SymbolicKinematics(config, numeric.joints)
     dt = 0.0123  # a control period no other test compiles for: the process's compiled QPs start empty for it
-    qps = CompiledQps(symbolic, numeric, dt)
-    first = qps.for_goal(*_reach_goal(config, numeric, 0.0))
+    qps = QpCache(symbolic, numeric)
+    first = qps.for_goal(*_reach_goal(config, numeric, 0.0), dt)
     tasks, box, limits = _reach_goal(config, numeric, 0.05)  # new targets, outlines and speeds
-    second = qps.for_goal(tasks, box, limits)
+    second = qps.for_goal(tasks, box, limits, dt)
     assert second is first and len(qps.compile_times) == 1 and len(qps.bind_times) == 1
     # another controller in the process reuses the compiled function, with buffers of its own
-    other = CompiledQps(symbolic, RobotKinematics(config, numeric.joints), dt)
-    third = other.for_goal(*_reach_goal(config, numeric, 0.1))
+    other = QpCache(symbolic, RobotKinematics(config, numeric.joints))
+    third = other.for_goal(*_reach_goal(config, numeric, 0.1), dt)
     assert third is not second and not other.compile_times and len(other.bind_times) == 1
     rng = np.random.default_rng(2)
     for _ in range(20):
@@ -184,5 +186,5 @@ def test_a_goal_like_an_earlier_one_reuses_its_compiled_qp_with_its_own_numbers(
         assert got.solved == expected.solved
         assert np.allclose(got.step, expected.step, atol=1e-9)
     # another kind of goal (no gaze) is compiled for itself
-    qps.for_goal(tasks[:2], box, limits)
+    qps.for_goal(tasks[:2], box, limits, dt)
     assert len(qps.compile_times) == 2

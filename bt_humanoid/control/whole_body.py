@@ -29,7 +29,7 @@ from bt_humanoid.control.base_motion import BaseMotion
 from bt_humanoid.control.joint_motion import JointReferenceController
 from bt_humanoid.control.motion import MotionHandle, plan_trajectory
 from bt_humanoid.control.wbc import RobotKinematics
-from bt_humanoid.control.wbc.compiled import CompiledQp, CompiledQps
+from bt_humanoid.control.wbc.compiled import CompiledQp, QpCache
 from bt_humanoid.control.wbc.limits import JointPositionLimit, Limit, TorsoMarginLimit, VelocityLimit
 from bt_humanoid.control.wbc.solver import BoxLimit
 from bt_humanoid.control.wbc.symbolic_kinematics import symbolic_kinematics
@@ -123,7 +123,7 @@ class WholeBodyController:
         self.conic_times: deque[float] = deque(maxlen=100_000)  # of which in the conic solver
         self.dt = 0.01
         # each kind of goal's QP is compiled once per process, from the kinematics in symbols
-        self.qps = CompiledQps(symbolic_kinematics(config, self.names), self.kinematics, self.dt)
+        self.qps = QpCache(symbolic_kinematics(config, self.names), self.kinematics)
 
     # ------------------------------------------------------------------ queries
 
@@ -252,8 +252,7 @@ class WholeBodyController:
         self.reference[:base] = self._base_pose()
         self._update(self.kinematics, self.reference)
         if goal.qp is None:
-            self.qps.dt = self.dt
-            goal.qp = self.qps.for_goal(goal.tasks, goal.box_limits, goal.limits)
+            goal.qp = self.qps.for_goal(goal.tasks, goal.box_limits, goal.limits, self.dt)
         solution = goal.qp.solve(self.reference, self.kinematics.q)
         self.solve_times.append(solution.solve_time)
         self.conic_times.append(solution.conic_time)

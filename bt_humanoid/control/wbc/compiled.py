@@ -49,12 +49,11 @@ def compile_qp(
     box_limits: list[BoxLimit],
     limits: list[Limit],
     dt: float,
-    damping: float = 1e-4,
 ) -> tuple[QpFunction, list[Parameter]]:
     """The QP of ``tasks`` within every limit, as ``qp_terms`` builds it, compiled; with the parameters these
     tasks and limits asked for (to ``bind`` them)."""
     with kinematics.recording_parameters() as parameters:
-        terms = qp_terms(kinematics, tasks, box_limits, limits, dt, damping)
+        terms = qp_terms(kinematics, tasks, box_limits, limits, dt)
     inputs = [kinematics.controlled, kinematics.configuration, ca.vertcat(*(ca.vec(p.symbol) for p in parameters))]
     outputs = [
         ca.densify(ca.SX(term))
@@ -68,7 +67,7 @@ def compile_qp(
         )
     ]
     layout = tuple((p.shape, p.moving) for p in parameters)
-    rows = int(outputs[3].numel())
+    rows = int(ca.SX(terms.constraints_lower).numel())
     function = ca.Function("whole_body_qp", inputs, outputs)
     return QpFunction(function, layout, len(kinematics.joints), rows, kinematics.model.nq), parameters
 
@@ -126,34 +125,34 @@ class CompiledQp:
 _functions: dict[tuple, QpFunction] = {}  # the process's compiled QPs, per robot, joints, dt and goal signature
 
 
-class CompiledQps:
+class QpCache:
     """A whole-body controller's QPs, one per kind of goal (its tasks' and limits' signatures), each bound in
     turn to the goals of that kind."""
 
-    def __init__(self, symbolic: SymbolicKinematics, numeric: RobotKinematics, dt: float) -> None:
-        self.symbolic, self.numeric, self.dt = symbolic, numeric, dt
+    def __init__(self, symbolic: SymbolicKinematics, numeric: RobotKinematics) -> None:
+        self.symbolic, self.numeric = symbolic, numeric
         self._mine: dict[tuple, CompiledQp] = {}
         self.compile_times: list[float] = []  # s for each QP this controller compiled
         self.bind_times: list[float] = []  # s for each goal served by a QP compiled before (here or elsewhere)
 
-    def for_goal(self, tasks: list[Task], box_limits: list[BoxLimit], limits: list[Limit]) -> CompiledQp:
-        """The compiled QP of this goal, bound to its tasks and limits."""
+    def for_goal(self, tasks: list[Task], box_limits: list[BoxLimit], limits: list[Limit], dt: float) -> CompiledQp:
+        """The compiled QP of this goal (``dt`` s per control step), bound to its tasks and limits."""
         started = time.perf_counter()
         key = (
             self.symbolic.robot,
             tuple(self.symbolic.joints),
-            self.dt,
+            dt,
             tuple(t.signature() for t in tasks),
             tuple(b.signature() for b in box_limits),
             tuple(lim.signature() for lim in limits),
         )
         compiled = key not in _functions
         if compiled:
-            _functions[key], parameters = compile_qp(self.symbolic, tasks, box_limits, limits, self.dt)
+            _functions[key], parameters = compile_qp(self.symbolic, tasks, box_limits, limits, dt)
         else:
             # the numbers are read by building the QP from numbers: the same calls, in the same order
             with self.numeric.recording_parameters() as parameters:
-                qp_terms(self.numeric, tasks, box_limits, limits, self.dt)
+                qp_terms(self.numeric, tasks, box_limits, limits, dt)
         if key not in self._mine:
             self._mine[key] = CompiledQp(_functions[key])
         qp = self._mine[key]

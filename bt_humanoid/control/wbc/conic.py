@@ -46,7 +46,9 @@ class Conic:
         (an infeasible problem, or no convergence)."""
         try:
             self._evaluate()
-        except RuntimeError:  # casadi's "conic process failed"
+        except RuntimeError as error:
+            if "conic process failed" not in str(error):
+                raise  # not the solver's verdict: a mistake in how the problem was set up
             return False
         return True
 

@@ -75,9 +75,10 @@ def log3(rotation: Value) -> Value:
     """The rotation vector (axis × angle) of a rotation matrix, as ``pinocchio.log3``.
 
     In symbols: the angle from the trace, the axis from the skew part, with
-    the series of θ / sin θ near zero. Accurate to about 1e-6 rad within 0.01
-    rad of a half turn, where the skew part vanishes; a whole-body task's
-    target moves a little each step, so its error stays far from there.
+    the series of θ / sin θ near zero. Exact to about 1e-7 rad up to 1e-5 rad
+    short of a half turn, and wrong within about 1e-6 rad of it, where the
+    skew part vanishes; a whole-body task's target moves a little each step,
+    so its error stays far from there.
     """
     if not is_symbolic(rotation):
         return pin.log3(rotation)

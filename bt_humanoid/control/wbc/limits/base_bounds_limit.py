@@ -21,7 +21,7 @@ class BaseBoundsLimit(Limit):
         self.gain = gain
 
     def signature(self) -> tuple:
-        return ("BaseBoundsLimit", self.base_frame, self.radius, self.gain)
+        return (type(self).__qualname__, self.base_frame, self.radius, self.gain)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         centre = kinematics.position(self.base_frame)[:2]

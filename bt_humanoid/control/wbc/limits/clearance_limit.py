@@ -27,7 +27,7 @@ class ClearanceLimit(Limit):
         return bool(_within(self.region, xy))
 
     def signature(self) -> tuple:
-        return ("ClearanceLimit", self.frame, self.gain)
+        return (type(self).__qualname__, self.frame, self.gain)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         position = kinematics.position(self.frame)

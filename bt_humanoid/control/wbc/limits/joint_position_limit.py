@@ -17,7 +17,7 @@ class JointPositionLimit:
         self.gain = gain
 
     def signature(self) -> tuple:
-        return ("JointPositionLimit", self.gain)
+        return (type(self).__qualname__, self.gain)
 
     def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[Value, Value]:
         q = kinematics.positions

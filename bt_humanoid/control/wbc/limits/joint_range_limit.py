@@ -21,7 +21,7 @@ class JointRangeLimit(Limit):
         self.gain = gain
 
     def signature(self) -> tuple:
-        return ("JointRangeLimit", tuple(self.ranges.items()), self.gain)
+        return (type(self).__qualname__, tuple(self.ranges.items()), self.gain)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         n = len(kinematics.joints)

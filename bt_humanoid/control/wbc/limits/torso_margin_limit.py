@@ -20,7 +20,7 @@ class TorsoMarginLimit(Limit):
         self.gain = gain
 
     def signature(self) -> tuple:
-        return ("TorsoMarginLimit", self.torso, tuple(self.margins.items()), self.gain)
+        return (type(self).__qualname__, self.torso, tuple(self.margins.items()), self.gain)
 
     def inequality(self, kinematics: RobotKinematics, dt: float) -> Inequality:
         torso = kinematics.position(self.torso)[:2]

@@ -15,7 +15,7 @@ class VelocityLimit:
         self.max_velocity = np.asarray(max_velocity, dtype=float)
 
     def signature(self) -> tuple:
-        return ("VelocityLimit",)
+        return (type(self).__qualname__,)
 
     def bounds(self, kinematics: RobotKinematics, dt: float) -> tuple[Value, Value]:
         speed = kinematics.parameter(lambda: self.max_velocity, (len(self.max_velocity), 1))  # frozen joints: 0
