@@ -125,10 +125,8 @@ class RobotKinematics(RecordsParameters):
         self.positions = np.zeros(len(self.joints))  # controlled joints, as last set by update()
         self._q_index, self._v_index = controlled_indices(self.model, config, self.joints)
         self._frame_ids: dict[str, int] = {}
-        self._jacobians: dict[str, np.ndarray] = {}  # per update(): tasks and limits ask for the same frames
-        self._positions: dict[str, np.ndarray] = {}  # per update(), as the Jacobians: Pinocchio copies on each read
-        self._rotations: dict[str, np.ndarray] = {}
-        self._placed_q: np.ndarray | None = None  # the configuration the frame placements are of
+        self._jacobians: dict[str, np.ndarray] = {}  # per configuration: tasks and limits ask for the same frames
+        self._placed_q: np.ndarray | None = None  # the configuration the frame placements are of; None: not yet
         self._joint_jacobians = False  # whether Pinocchio's joint Jacobians are of it too (computed on demand)
 
     def index(self, joint: str) -> int:
@@ -141,18 +139,23 @@ class RobotKinematics(RecordsParameters):
         return np.asarray(read(), dtype=float)
 
     def update(self, positions: np.ndarray) -> None:
-        """Set the controlled joints (other joints stay at their last value) and recompute kinematics: frame
-        placements now, Jacobians when first asked for; nothing when the configuration has not changed (a
-        control step asks where the hands are several times)."""
+        """Set the controlled joints (other joints stay at their last value). Frame placements and Jacobians
+        are computed when first asked for and kept while the configuration stays (a control step asks where the
+        hands are several times; a step of the compiled QP asks for none)."""
         self._set(positions)
         if self._placed_q is not None and np.array_equal(self.q, self._placed_q):
             return
-        pin.framesForwardKinematics(self.model, self.data, self.q)
-        self._placed_q = self.q.copy()
+        self._moved()
+
+    def _moved(self) -> None:
+        self._placed_q = None
         self._joint_jacobians = False
         self._jacobians.clear()
-        self._positions.clear()
-        self._rotations.clear()
+
+    def _place(self) -> None:
+        if self._placed_q is None:
+            pin.framesForwardKinematics(self.model, self.data, self.q)
+            self._placed_q = self.q.copy()
 
     def _set(self, positions: np.ndarray) -> None:
         self.positions = np.array(positions, dtype=float)
@@ -161,7 +164,7 @@ class RobotKinematics(RecordsParameters):
     def mass_matrix(self, positions: np.ndarray) -> np.ndarray:
         """Joint-space inertia (n × n over the controlled joints) at ``positions`` (no Jacobians: dynamics only)."""
         self._set(positions)
-        self._placed_q = None  # crba leaves the data at these positions: update() must place frames afresh
+        self._moved()  # crba leaves the data at these positions: frames are placed afresh when asked for
         full = pin.crba(self.model, self.data, self.q)
         full = np.triu(full) + np.triu(full, 1).T  # Pinocchio fills the upper triangle only
         return full[np.ix_(self._v_index, self._v_index)]
@@ -171,23 +174,21 @@ class RobotKinematics(RecordsParameters):
 
     def pose(self, frame: str) -> pin.SE3:
         """World pose of a frame (site, body or camera name)."""
+        self._place()
         return self.data.oMf[self.frame_id(frame)]
 
     def position(self, frame: str) -> np.ndarray:
-        """World position of a frame (read only: shared until the next update)."""
-        if frame not in self._positions:
-            self._positions[frame] = self.pose(frame).translation
-        return self._positions[frame]
+        """World position of a frame."""
+        return self.pose(frame).translation
 
     def rotation(self, frame: str) -> np.ndarray:
-        """World orientation of a frame as a rotation matrix (read only: shared until the next update)."""
-        if frame not in self._rotations:
-            self._rotations[frame] = self.pose(frame).rotation
-        return self._rotations[frame]
+        """World orientation of a frame as a rotation matrix."""
+        return self.pose(frame).rotation
 
     def jacobian(self, frame: str) -> np.ndarray:
         """6 × n Jacobian (linear; angular) of the frame origin in world-aligned axes."""
         if frame not in self._jacobians:
+            self._place()
             if not self._joint_jacobians:
                 pin.computeJointJacobians(self.model, self.data, self.q)
                 self._joint_jacobians = True

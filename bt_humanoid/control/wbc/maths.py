@@ -89,11 +89,6 @@ def log3(rotation: Value) -> Value:
     return factor * skew
 
 
-def constant(value: Value, like: Value) -> Value:
-    """``value`` as the kind of ``like`` (a numpy array of numbers, or a CasADi constant among symbols)."""
-    return ca.SX(np.asarray(value, dtype=float)) if is_symbolic(like) else np.asarray(value, dtype=float)
-
-
 def outer(a: Value, b: Value) -> Value:
     """a bᵀ."""
     return a @ ca.SX(b).T if is_symbolic(a, b) else np.outer(a, b)

@@ -7,7 +7,8 @@
 solved with a CasADi conic solver (DAQP by default: dense active-set, exact,
 fastest of those CasADi offers for this size), built once per problem shape
 and reused, fed through a buffer (``conic.py``). ``qp_terms`` builds the terms from numbers or from symbols;
-``solve_ik`` solves them from numbers, ``CompiledQp`` (``compiled.py``) from a function compiled once per goal.
+``solve_ik`` solves them from numbers, ``CompiledQp`` (``compiled.py``) from a function compiled once per kind
+of goal.
 """
 
 from __future__ import annotations
@@ -71,9 +72,9 @@ def qp_terms(
         low, high = box.bounds(kinematics, dt)
         lower, upper = maximum(lower, low), minimum(upper, high)
     lower = minimum(lower, upper)  # conflicting bounds: hold still rather than fail
-    inequalities = [limit.inequality(kinematics, dt) for limit in limits]
-    G = stack_rows([ineq.G for ineq in inequalities if ineq.G.shape[0]], n)
-    h = concat([ineq.lower for ineq in inequalities if ineq.G.shape[0]]) if G.shape[0] else np.zeros(0)
+    inequalities = [ineq for ineq in (limit.inequality(kinematics, dt) for limit in limits) if ineq.G.shape[0]]
+    G = stack_rows([ineq.G for ineq in inequalities], n)
+    h = concat([ineq.lower for ineq in inequalities]) if inequalities else np.zeros(0)
     return QpTerms(hessian, gradient, G, h, lower, upper)
 
 

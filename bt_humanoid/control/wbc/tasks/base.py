@@ -20,15 +20,13 @@ class Task(ABC):
     Both are written with ``maths``' operations, so they work on a
     ``RobotKinematics`` (numbers) and on a ``SymbolicKinematics`` (CasADi
     symbols, from which the whole-body controller compiles its QP once per
-    goal). A target that moves during a goal is read through
-    ``kinematics.parameter``.
+    kind of goal). The numbers that differ between goals of one signature, or
+    move during one, are read through ``kinematics.parameter``.
     """
 
     def __init__(self, weight: float | np.ndarray = 1.0, gain: float = 1.0) -> None:
         self.weight = weight
         self.gain = gain
-        # the weight per row, built once and reused by the control loop while ``weight`` stays the same object
-        self._row_weights: tuple[object, np.ndarray] | None = None
 
     @abstractmethod
     def error(self, kinematics: RobotKinematics) -> Value: ...
@@ -39,11 +37,8 @@ class Task(ABC):
     def residual(self, kinematics: RobotKinematics) -> tuple[Value, Value, np.ndarray]:
         """(J, gain · e, per-row weight): the rows this task adds to the stacked least-squares problem."""
         err = self.gain * self.error(kinematics)
-        weight, size = self.weight, err.shape[0]
-        if self._row_weights is None or self._row_weights[0] is not weight or len(self._row_weights[1]) != size:
-            rows = weight if isinstance(weight, np.ndarray) else np.full(size, float(weight))
-            self._row_weights = (weight, rows)
-        return self.jacobian(kinematics), err, self._row_weights[1]
+        weight = self.weight if isinstance(self.weight, np.ndarray) else np.full(err.shape[0], float(self.weight))
+        return self.jacobian(kinematics), err, weight
 
     def signature(self) -> tuple:
         """What a compiled QP fixes of this task: two tasks of one signature differ only in the numbers they

@@ -20,19 +20,18 @@ class PostureTask(Task):
         self._columns: np.ndarray | None = None  # the posture's joints among the controlled ones
         self._selection: np.ndarray | None = None  # its Jacobian: one row per joint, a 1 in that joint's column
 
-    def _select(self, kinematics: RobotKinematics) -> np.ndarray:
-        if self._columns is None:
+    def _select(self, kinematics: RobotKinematics) -> tuple[np.ndarray, np.ndarray]:
+        if self._columns is None or self._selection is None:
             self._columns = np.array([kinematics.index(joint) for joint in self.posture], dtype=int)
             self._selection = np.eye(len(kinematics.joints))[self._columns]
-        return self._columns
+        return self._columns, self._selection
 
     def error(self, kinematics: RobotKinematics) -> Value:
         target = kinematics.parameter(lambda: self.target, (len(self.target), 1))
-        return target - kinematics.positions[self._select(kinematics)]
+        return target - kinematics.positions[self._select(kinematics)[0]]
 
     def _fixed(self) -> tuple:
         return tuple(self.posture)
 
     def jacobian(self, kinematics: RobotKinematics) -> np.ndarray:
-        self._select(kinematics)
-        return self._selection
+        return self._select(kinematics)[1]
