@@ -272,39 +272,6 @@ def test_a_world_can_extend_another_and_add_a_walking_person():
 
 
 @pytest.mark.sim
-def test_a_walker_waits_for_a_robot_in_the_way_then_turns_back():
-    """The robot stands on the person's loop: they stop short of it, and after a while walk the loop the other way."""
-    mission = {"mission": "in the way", "world": "apartment_busy", "tree": {"wait": {"seconds": 12}}}
-    run = build_run(mission, robot_start=(4.7, -0.6, 90.0))  # on the loop's west leg, which they walk north
-    walker = run.sim.walkers[0]
-    contacts = _watch_contacts(run)
-    trail: list[np.ndarray] = []
-    run.executor.observers.append(lambda: trail.append(walker.position().copy()))
-    run.execute()
-    apart = np.hypot(*(np.array(trail) - [4.7, -0.6]).T)
-    assert apart.min() > 0.32 + 0.2 + 0.1, "stopped short of the robot's base"
-    assert walker.direction == -1 and trail[-1][0] > 5.3, "turned back, and went round the other way"
-    assert not [c for c in contacts if "walker" in c[1]]
-
-
-@pytest.mark.sim
-def test_crossing_the_walking_persons_loop_never_touches_them():
-    mission = {"mission": "cross", "world": "apartment_busy", "tree": {"navigate": {"place": "kitchen"}}}
-    run = build_run(mission, robot_start=(3.6, -1.5, 0.0))  # south of the table, the person's loop ahead
-    contacts = _watch_contacts(run)
-    apart: list[float] = []
-    run.executor.observers.append(
-        lambda: apart.append(float(np.hypot(*(run.truth.robot_pose()[:2] - run.sim.walkers[0].position()))))
-    )
-    scenario = Scenario(run, run.execute())
-    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
-    assert min(apart) < 1.5, "their ways crossed (the person is 0.2 m in radius, the robot 0.32 m)"
-    assert not [c for c in contacts if "walker" in c[1]]
-    x, y, _ = scenario.truth.robot_pose()
-    assert math.hypot(x - 7.0, y - 2.4) <= 0.05
-
-
-@pytest.mark.sim
 def test_the_small_moves_of_recovery_turn_back_up_and_spin():
     mission = {
         "mission": "small moves",

@@ -134,13 +134,13 @@ def test_a_simulation_takes_the_robots_models_unless_ideal_sensors_are_asked_for
 def test_each_sensor_has_its_own_stream_and_the_same_seed_gives_the_same_noise(monkeypatch):
     sim = sim_with(monkeypatch, ideal=False)
     sim.reset(3)
-    first = sim.sensor_rng("head_camera.depth").random(4)
-    other = sim.sensor_rng("scanner").random(4)
+    first = sim.random_stream("head_camera.depth").random(4)
+    other = sim.random_stream("scanner").random(4)
     sim.reset(3)
-    assert np.array_equal(sim.sensor_rng("head_camera.depth").random(4), first)
+    assert np.array_equal(sim.random_stream("head_camera.depth").random(4), first)
     assert not np.array_equal(first, other)
     sim.reset(4)
-    assert not np.array_equal(sim.sensor_rng("head_camera.depth").random(4), first)
+    assert not np.array_equal(sim.random_stream("head_camera.depth").random(4), first)
 
 
 def test_the_robots_encoders_count_steps_but_its_base_pose_is_not_an_encoder(monkeypatch):

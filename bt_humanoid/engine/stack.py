@@ -173,7 +173,7 @@ class RobotStack:
             return [robot.hand_position(side) for side in config.grippers]
 
         def noise(ranges: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # the robot's range model, its own stream
-            return scanner_ranges(self.sim.sensors.scanner, ranges, self.sim.sensor_rng("scanner"))
+            return scanner_ranges(self.sim.sensors.scanner, ranges, self.sim.random_stream("scanner"))
 
         def zone(name: str, distance: float) -> None:
             self.events.add(self.sim.time, "separation", zone=name, distance=round(distance, 3))

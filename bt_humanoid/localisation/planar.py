@@ -65,7 +65,7 @@ def planar_localisation(sim: Simulation, io: MujocoRobotIO) -> PlanarLocalisatio
     if not localises(sim):
         return None
     scan_map = ScanMap.for_robot(sim)
-    odometry = WheelOdometry(sim.sensors.odometry, sim.sensor_rng("odometry"))
+    odometry = WheelOdometry(sim.sensors.odometry, sim.random_stream("odometry"))
     # the filter allows 2.5 σ of the wheels' scale error (their calibration's spec)
     share = max(ODOMETRY_SHARE, 2.5 * sim.sensors.odometry.scale)
     localisation = PlanarLocalisation(io, odometry, Localiser(scan_map, io.positions(), odometry_share=share))

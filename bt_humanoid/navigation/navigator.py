@@ -66,7 +66,7 @@ class Navigator:
         if camera:
 
             def noise(ranges: np.ndarray) -> np.ndarray:  # the robot's depth model, on the camera's own stream
-                return depth_ranges(sim.sensors.depth, ranges, sim.sensor_rng(f"{camera}.mapping"))
+                return depth_ranges(sim.sensors.depth, ranges, sim.random_stream(f"{camera}.mapping"))
 
             self.camera = DepthCamera(
                 sim.model, sim.data, camera, sim.robot_root, noise=noise, on_map=lambda p, r: sim.on_map(p, r)

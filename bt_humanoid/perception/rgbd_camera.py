@@ -101,8 +101,8 @@ class RgbdCamera:
         depth = self._render(self._depth).astype(np.float64)
         models = self.sim.sensors
         # depth is lost on dark surfaces: how dark they are, not how the colour stream's noise shows them
-        depth = depth_image(models.depth, depth, rgb, self.focal, self.sim.sensor_rng(f"{self.name}.depth"))
-        rgb = colour_image(models.colour, rgb, self.sim.sensor_rng(f"{self.name}.colour"))
+        depth = depth_image(models.depth, depth, rgb, self.focal, self.sim.random_stream(f"{self.name}.depth"))
+        rgb = colour_image(models.colour, rgb, self.sim.random_stream(f"{self.name}.colour"))
         position, rotation = self.sim.on_map(
             data.cam_xpos[self.camera].copy(), data.cam_xmat[self.camera].reshape(3, 3)
         )

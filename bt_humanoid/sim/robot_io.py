@@ -85,7 +85,7 @@ class MujocoRobotIO:
         rates and specific force with its white noise."""
         reading = self.sim.data.sensor(name).data
         if name in self._imu_noise:
-            return reading + self.sim.sensor_rng(name).standard_normal(reading.shape) * self._imu_noise[name]
+            return reading + self.sim.random_stream(name).standard_normal(reading.shape) * self._imu_noise[name]
         return reading
 
     def command(self, actuators: np.ndarray, values: np.ndarray) -> None:

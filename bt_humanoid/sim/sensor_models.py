@@ -1,7 +1,7 @@
 """What real sensors add to the simulator's exact readings: noise, missing returns, quantisation, exposure.
 
 MuJoCo renders and ray-casts the scene exactly; a real robot never sees it so. Each model here takes an exact
-reading and the sensor's own random stream (``Simulation.sensor_rng``, seeded from the run's seed, so the same
+reading and the sensor's own random stream (``Simulation.random_stream``, seeded from the run's seed, so the same
 seed gives the same noise) and returns what the sensor would report. The figures are robot.yaml's ``sensors:``
 (defaults below, each with where it comes from); ``--ideal-sensors`` (or ``BT_IDEAL_SENSORS=1``) turns every
 model off for debugging. The base's planar joints are not encoders here: what the wheels measure is

@@ -37,7 +37,7 @@ class Simulation:
         self.robot = robot
         #: what the robot's sensors add to the truth: robot.yaml's models, or none (--ideal-sensors)
         self.sensors = SensorModels.ideal() if ideal_sensors_requested() else robot.sensors
-        self._sensor_rngs: dict[str, np.random.Generator] = {}
+        self._random_streams: dict[str, np.random.Generator] = {}
         #: places a pose a body-mounted sensor measured in the world (MuJoCo's frame) on the robot's map: through
         #: where the robot believes its base is (set by localisation; exact where there is none)
         self.on_map: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] = _exact_pose
@@ -71,7 +71,7 @@ class Simulation:
         #: controller: its legs are torque-controlled, and a torque holds only until the next command)
         self.physics_controllers: list[Callable[[], None]] = []
         self.walkers = [
-            WalkerDriver(self.model, self.data, name, walker, root, self.robot_bodies)
+            WalkerDriver(self.model, self.data, name, walker, self.robot_bodies)
             for name, walker in world.walkers.items()
         ]
         #: a legged robot starts standing: its neutral stance, placed at the start pose
@@ -115,15 +115,17 @@ class Simulation:
                 self.data.ctrl[self.actuator_for_joint(joint)] = gripper.closed
         self.seed = seed  # the run's seed: whatever draws random numbers (route planning) starts from it
         self.rng = np.random.default_rng(seed)
-        self._sensor_rngs.clear()
+        self._random_streams.clear()
+        for walker in self.walkers:
+            walker.reset(self.random_stream(f"walker {walker.name}"))
         mujoco.mj_forward(self.model, self.data)
 
-    def sensor_rng(self, sensor: str) -> np.random.Generator:
-        """The named sensor's own random stream, from the run's seed: the same seed gives the same noise, and one
-        sensor's draws do not shift another's (or route planning's)."""
-        if sensor not in self._sensor_rngs:
-            self._sensor_rngs[sensor] = np.random.default_rng([self.seed, zlib.crc32(sensor.encode())])
-        return self._sensor_rngs[sensor]
+    def random_stream(self, name: str) -> np.random.Generator:
+        """A named random stream (a sensor's noise, a walker's choices) from the run's seed: the same seed gives the
+        same draws, and one stream's draws do not shift another's (or route planning's)."""
+        if name not in self._random_streams:
+            self._random_streams[name] = np.random.default_rng([self.seed, zlib.crc32(name.encode())])
+        return self._random_streams[name]
 
     def _check_hold(self, held: PlacedObject) -> Hold:
         """How the hand holds the scene's object; a UserError when this robot cannot hold it so."""

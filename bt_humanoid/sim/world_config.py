@@ -83,11 +83,19 @@ class Person(StrictModel):
 
 
 class Walker(StrictModel):
-    """A person who walks a loop through the scene, on their own legs (actuators), pausing for the robot."""
+    """A person who walks a loop through the scene, on their own legs (actuators), reacting to the robot as they
+    see it (sim/walkers.py)."""
 
     route: list[tuple[float, float]] = Field(min_length=2, description="[x, y] corners of the loop (m)")
     speed: float = Field(0.5, gt=0, le=2.0, description="walking speed (m/s)")
     radius: float = Field(0.2, gt=0, le=0.5, description="body radius (m)")
+    yields: float = Field(
+        0.8, ge=0, le=1, description="share of meetings in which they stop for the robot; in the others they pass it"
+    )
+    # about 0.7 s for an expected event, longer for a surprise (Green 2000, "How long does it take to stop?")
+    reaction_time: float = Field(0.7, ge=0, le=3.0, description="s from seeing the robot to acting on it")
+    # the human field of view spans about 200 degrees across (Spector 1990, Clinical Methods, ch. 116)
+    view_angle: float = Field(100.0, gt=0, le=180, description="half-angle they see round the way they walk (deg)")
 
 
 class Container(StrictModel):
