@@ -187,10 +187,13 @@ def _give(release_after: float | None, timeout: float) -> tuple[Scenario, list[f
 
 
 @pytest.mark.sim
-def test_give_holds_the_object_out_to_the_person_and_lets_go_after_the_timeout():
-    scenario, reach = _give(release_after=None, timeout=1.0)
-    assert scenario.result.tree_status == "SUCCESS", scenario.result.summary()
-    assert scenario.truth.in_hand("red cube") is None
+def test_give_to_a_person_out_of_reach_holds_it_out_asks_and_keeps_it():
+    """The person stands 4 m away in the living room: they never take it, so nothing is dropped."""
+    scenario, reach = _give(release_after=None, timeout=4.0)
+    assert scenario.result.tree_status == "FAILURE"
+    assert "person did not take the red cube in 4 s; still holding it" in scenario.result.summary()["cause"]
+    assert "Please take the red cube." in scenario.run.stack.said
+    assert scenario.truth.in_hand("red cube") == "right"
     base = scenario.truth.robot_pose()
     person = scenario.run.context.world_model.person("person")
     # held out towards the person: the hand got well ahead of the base on the way to them

@@ -59,6 +59,15 @@ class GripperController:
         # closing never "arrives" when something is in the way: skip the settle check, judge the width instead
         return self.joints.move({joint: value for joint in config.joints}, settle_check=(action == "open"))
 
+    def loosen(self, side: str, by: float) -> MotionHandle:
+        """Open the fingers ``by`` m wider than they stand now (no wider than open): off a thing, not far."""
+        config = self.grippers[side]
+        idx = self.joints.indices(config.joints)
+        now = self.joints.io.positions()[idx]
+        step = (config.open - config.closed) / max(abs(config.open - config.closed), 1e-9) * by / len(idx)
+        targets = np.clip(now + step, min(config.open, config.closed), max(config.open, config.closed))
+        return self.joints.move(dict(zip(config.joints, targets.tolist(), strict=True)))
+
     def start_closed(self, side: str) -> None:
         """Initial conditions, before the first step: the hand was closed on something when the run began (a
         scene handed the robot an object), so its fingers' references start shut and press on it at once."""

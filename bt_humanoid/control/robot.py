@@ -82,6 +82,11 @@ class RobotController:
         self.separation: Separation | None = None  # set with monitor_separation()
         self.control_period = 0.01  # s between step() calls; the executor sets it
 
+    def wrist_force(self, side: str) -> np.ndarray | None:
+        """What the wrist's force sensor reads (N, in the hand's frame), on a hand that has one (robot.yaml)."""
+        sensor = self.config.grippers[side].wrist_force
+        return None if sensor is None else self.body_io.sensor(sensor).copy()
+
     def set_control_period(self, period: float) -> None:
         """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""
         self.control_period = period

@@ -23,8 +23,6 @@ from bt_humanoid.mission.schema import (
 )
 from bt_humanoid.sim.ground_truth import GroundTruth
 
-HANDOVER_REACH = 1.0  # m (horizontal) from a person within which a let-go object counts as handed over
-
 
 @dataclass(frozen=True)
 class ConditionResult:
@@ -87,14 +85,16 @@ def check_condition(condition: SuccessCondition, truth: GroundTruth) -> Conditio
 
 
 def _handed_over(obj: str, truth: GroundTruth) -> tuple[bool, str]:
-    """Let go within reach of a person, and how far from the nearest."""
+    """In a person's hand (both their fingers on it); else where it is instead."""
+    taker = truth.held_by_person(obj)
+    if taker is not None:
+        return True, f"in the {taker}'s hand"
+    held = truth.in_hand(obj)
+    if held is not None:
+        return False, f"in the robot's {held} hand"
     x, y, _ = truth.object_position(obj)
     distance, person = min((math.dist((x, y), truth.person_position(p)[:2]), p) for p in truth.sim.world.people)
-    held = truth.in_hand(obj)
-    return (
-        held is None and distance <= HANDOVER_REACH,
-        f"in the {held} hand" if held else f"{distance:.2f} m from the {person}",
-    )
+    return False, f"not in a hand: {distance:.2f} m from the {person}"
 
 
 def _any(named: str, truth: GroundTruth, holds: Callable[[str], bool]) -> str:

@@ -246,16 +246,19 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
 
 
 def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:
-    """The simulation times at which the robot touches a person, filled while the run steps."""
+    """The simulation times at which the robot touches a person, filled while the run steps. A hand-over's touch,
+    the robot's hand on the person's hand, is part of it and not counted."""
     model = run.sim.model
     on_person = np.isin(model.geom_bodyid, sorted(run.truth.people_bodies()))  # per geom
     on_robot = np.isin(model.geom_bodyid, sorted(run.sim.robot_bodies))  # per geom
+    hand = run.truth.hand_geoms()
     touched: list[float] = []
 
     def watch() -> None:  # every control step: vectorised over the contacts
         contacts = run.sim.data.contact
         g1, g2 = contacts.geom1, contacts.geom2
-        if np.any((on_person[g1] & on_robot[g2]) | (on_person[g2] & on_robot[g1])):
+        touching = (on_person[g1] & on_robot[g2]) | (on_person[g2] & on_robot[g1])
+        if np.any(touching & ~(hand[g1] & hand[g2])):
             touched.append(run.sim.time)
 
     stack.observers.append(watch)

@@ -25,7 +25,6 @@ from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
-from bt_humanoid.engine.verdict import HANDOVER_REACH
 from bt_humanoid.sim.ground_truth import GroundTruth
 from bt_humanoid.sim.scene_config import SceneConfig
 from bt_humanoid.sim.world_config import WorldConfig
@@ -313,11 +312,8 @@ def _where(truth: GroundTruth, name: str, keeps_upright: bool) -> Where:
     for surface in world.surfaces:
         if truth.rests_on(name, surface):
             return ("on", surface) if truth.upright(name) or not keeps_upright else ("tipped", surface)
-    x, y, _ = truth.object_position(name)
-    for person in world.people:
-        if math.dist((x, y), truth.person_position(person)[:2]) <= HANDOVER_REACH:
-            return ("delivered", person)
-    return ("floor", "")
+    person = truth.held_by_person(name)
+    return ("delivered", person) if person is not None else ("floor", "")
 
 
 def places_reached(truth: GroundTruth) -> list[str]:

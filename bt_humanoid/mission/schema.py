@@ -92,7 +92,7 @@ class NearCondition(StrictModel):
 
 
 class DeliveredCondition(StrictModel):
-    delivered: str = Field(description="the object was handed over: out of the robot's hands, within 1 m of a person")
+    delivered: str = Field(description="the object was handed over: in a person's hand (both their fingers on it)")
 
 
 class GripperCondition(StrictModel):

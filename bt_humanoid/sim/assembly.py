@@ -16,6 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from bt_humanoid.sim.people import add_arm
 from bt_humanoid.sim.robot_config import RobotConfig
 from bt_humanoid.sim.scene_objects import PlacedObject, add_objects
 from bt_humanoid.sim.world_config import Walker, WorldConfig
@@ -70,6 +71,8 @@ def world_spec(world: WorldConfig, robot: RobotConfig, objects: list[PlacedObjec
     scene = mujoco.MjSpec.from_file(str(world.model_path))
     for body, walker in world.walkers.items():
         _add_walker(scene, body, walker)
+    for person in world.people.values():
+        add_arm(scene, person.body)
     add_objects(scene, world, objects or [])
     frame = scene.worldbody.add_frame()
     with _quiet_empty_prefix_warning():

@@ -12,6 +12,7 @@ import mujoco
 import numpy as np
 
 from bt_humanoid.sim.geometry import object_extents, rotation_of
+from bt_humanoid.sim.people import finger_names, person_hand
 from bt_humanoid.sim.simulation import Simulation
 
 UPRIGHT_TOLERANCE_DEG = 15.0
@@ -105,6 +106,14 @@ class GroundTruth:
         z_axis = self.data.xmat[self._object_body(obj)].reshape(3, 3)[:, 2]
         return bool(math.degrees(math.acos(np.clip(z_axis[2], -1, 1))) < UPRIGHT_TOLERANCE_DEG)
 
+    def held_by_person(self, obj: str) -> str | None:
+        """The person (world.yaml's name) whose two fingers both touch the object, else None."""
+        touching = {self.model.geom(g).name for g in self.geoms_in_contact(self._object_body(obj))}
+        for name, person in self.sim.world.people.items():
+            if set(finger_names(person.body)) <= touching:
+                return name
+        return None
+
     def in_hand(self, obj: str) -> str | None:
         """The side whose two finger pads both touch the object, else None."""
         touching = self.geoms_in_contact(self._object_body(obj))
@@ -119,9 +128,25 @@ class GroundTruth:
         return float(sum(self.data.qpos[self.model.joint(j).qposadr[0]] for j in joints))
 
     def people_bodies(self) -> set[int]:
-        """Bodies of the world's people and walkers."""
+        """Bodies of the world's people (their arms too) and walkers."""
         names = [p.body for p in self.sim.world.people.values()] + list(self.sim.world.walkers)
-        return {self.model.body(name).id for name in names}
+        roots = {self.model.body(name).id for name in names}
+        return {b for b in range(self.model.nbody) if self.model.body_rootid[b] in roots}
+
+    def hand_geoms(self) -> np.ndarray:
+        """Per geom: is it on a hand, the robot's (below a gripper's wrist) or a person's (``sim/people.py``)? A
+        hand-over brings the two together, and their touching is part of it, not a collision."""
+        hands = {self.model.site(g.grip_site).bodyid[0] for g in self.sim.robot.grippers.values()}
+        robot = {b for b in range(self.model.nbody) if self._below(b, hands)}
+        people = {self.model.body(name).id for p in self.sim.world.people.values() for name in person_hand(p.body)}
+        return np.isin(self.model.geom_bodyid, sorted(robot | people))
+
+    def _below(self, body: int, ancestors: set[int]) -> bool:
+        while body > 0:
+            if body in ancestors:
+                return True
+            body = int(self.model.body_parentid[body])
+        return False
 
     def robot_contacts(self) -> list[tuple[str, str]]:
         """Contacts between the robot and anything else, as (robot geom, other geom) names."""

@@ -20,6 +20,7 @@ import numpy as np
 from bt_humanoid.errors import UserError
 from bt_humanoid.sim.assembly import world_spec
 from bt_humanoid.sim.holding import CARRY_POSTURE, SQUEEZE, Hold, hold_for
+from bt_humanoid.sim.people import PersonDriver
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
 from bt_humanoid.sim.scene_config import SceneConfig, load_scene, start_pose
 from bt_humanoid.sim.scene_objects import PlacedObject, SceneError, place_scene, surface_tops
@@ -74,6 +75,11 @@ class Simulation:
             WalkerDriver(self.model, self.data, name, walker, self.robot_bodies)
             for name, walker in world.walkers.items()
         ]
+        #: the people who take what the robot hands them (their arms' scripts)
+        self.people = {
+            name: PersonDriver(self.model, self.data, person.body, person.takes, self.object_bodies, self.robot_bodies)
+            for name, person in world.people.items()
+        }
         #: a legged robot starts standing: its neutral stance, placed at the start pose
         self.stance: Stance | None = standing_posture(robot) if robot.legs is not None else None
         self.reset()
@@ -118,6 +124,8 @@ class Simulation:
         self._random_streams.clear()
         for walker in self.walkers:
             walker.reset(self.random_stream(f"walker {walker.name}"))
+        for person in self.people.values():
+            person.reset()
         mujoco.mj_forward(self.model, self.data)
 
     def random_stream(self, name: str) -> np.random.Generator:
@@ -200,6 +208,8 @@ class Simulation:
     def step(self, n: int = 1) -> None:
         for walker in self.walkers:  # the scene's people act at the caller's rate (the control period)
             walker.control()
+        for person in self.people.values():
+            person.control()
         if not self.physics_controllers:
             mujoco.mj_step(self.model, self.data, nstep=n)
             return

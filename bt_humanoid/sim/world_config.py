@@ -80,6 +80,11 @@ class WorldObject(StrictModel):
 class Person(StrictModel):
     body: str
     aliases: list[str] = Field(default_factory=list)
+    takes: bool = Field(
+        True,
+        description="reaches for what the robot holds out to them and takes it (an arm and hand are built onto "
+        "their body, sim/people.py); false: busy, they never reach",
+    )
 
 
 class Walker(StrictModel):

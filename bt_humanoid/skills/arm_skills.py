@@ -19,6 +19,13 @@ from bt_humanoid.strict_model import StrictModel, exactly_one
 
 GIVE_REACH = 0.5  # m ahead of the base, towards the person, where the hand holds the object out
 GIVE_HEIGHT = 1.0  # m
+# A giver lets go as the taker takes the load (Chan et al. 2012, "Grip forces and load forces in handovers"): the
+# wrist's force sensor reads the person's pull, or their lifting, against what it read holding the thing out still.
+SETTLE = 0.5  # s the held-out hand is read still before the pull is looked for
+PULL = 4.0  # N of change in the wrist's force that is the person taking it ...
+PULL_FOR = 0.15  # s ... felt this long
+LOOSEN = 0.03  # m the fingers open by: off the thing, short of the person's hand round it
+LIFT_CLEAR = 0.12  # m the empty hand rises, up out of the person's grip
 
 
 class LookAtParams(StrictModel):
@@ -78,11 +85,17 @@ class Reach(_ManipulationSkill):
 class GiveParams(StrictModel):
     to: str = Field("person", description="a person of the world (name or alias)")
     side: Side = Field("right", description="the hand holding the object")
-    timeout: float = Field(10.0, gt=0, le=120, description="s to wait for the person to take it before letting go")
+    timeout: float = Field(
+        20.0, gt=0, le=120, description="s to wait for the person to take it (asked half-way); then it fails, held"
+    )
     release_key: str = Field("release", description="blackboard key that, once true, means 'let go now'")
 
 
-@skill("give", "hold the object out to a person; let go when asked (blackboard) or after a timeout")
+@skill(
+    "give",
+    "hold the object out to a person; let go when they take it (the wrist feels the pull) or when asked "
+    "(blackboard); ask them half-way through the wait, and keep holding it if they never do",
+)
 class Give(_ManipulationSkill):
     Params = GiveParams
 
@@ -96,6 +109,7 @@ class Give(_ManipulationSkill):
             ("hold out", self._hold_out),
             ("wait", self._wait),
             ("let go", self._let_go),
+            ("draw back", self._draw_back),
         ]
 
     def _face(self) -> MotionHandle:
@@ -122,22 +136,49 @@ class Give(_ManipulationSkill):
         )
 
     def _wait(self) -> MotionHandle:
-        # no controller drives this wait: poll() settles the handle from the blackboard and the clock
+        # no controller drives this wait: poll() settles the handle from the wrist, the blackboard and the clock
         self.wait_started = self.context.clock()
+        self.still: list[np.ndarray] = []  # the wrist's readings while held out still: what no pull reads
+        self.pulled_since: float | None = None
+        self.asked = False
         return MotionHandle("holding it out")
 
     def poll(self):
         if self.phase == "wait" and self.motion is not None and not self.motion.done:
-            waited = self.context.clock() - self.wait_started
-            if self.context.blackboard.values.get(self.params.release_key):
-                self.motion.succeed("asked to let go")
-            elif waited > self.params.timeout:
-                self.motion.succeed(f"let go after {self.params.timeout:.0f} s")
-            else:
-                self.motion.feedback = f"holding it out for {waited:.0f} s"
+            self._watch_the_wait()
         return super().poll()
+
+    def _watch_the_wait(self) -> None:
+        p: GiveParams = self.params
+        now = self.context.clock()
+        waited = now - self.wait_started
+        force = self.context.robot.wrist_force(p.side)
+        if self.context.blackboard.values.get(p.release_key):
+            self.motion.succeed("asked to let go")
+            return
+        if force is not None and waited < SETTLE:
+            self.still.append(force)
+        elif force is not None and self.still:
+            change = float(np.linalg.norm(force - np.mean(self.still, axis=0)))
+            self.pulled_since = (self.pulled_since or now) if change > PULL else None
+            if self.pulled_since is not None and now - self.pulled_since >= PULL_FOR:
+                self.motion.succeed(f"{p.to} took it: the wrist felt {change:.1f} N")
+                return
+        if waited > p.timeout:
+            self.motion.fail(f"{p.to} did not take the {self.held.name} in {p.timeout:.0f} s; still holding it")
+        elif waited > p.timeout / 2 and not self.asked:
+            self.asked = True
+            self.context.speak(f"Please take the {self.held.name}.")
+        else:
+            self.motion.feedback = f"holding it out for {waited:.0f} s"
 
     def _let_go(self) -> MotionHandle:
         self.held.held_by = None
         self.held.confidence = 0.0  # handed over: no longer on any surface we know
-        return self.context.robot.grippers.command(self.params.side, "open")
+        return self.context.robot.grippers.loosen(self.params.side, LOOSEN)
+
+    def _draw_back(self) -> MotionHandle:
+        """Up, out of the person's grip: the loosened fingers slide off what they now hold."""
+        hand = self.context.robot.whole_body.frame_pose(self.context.robot_config.grippers[self.params.side].grip_site)
+        target = pin.SE3(hand.rotation, hand.translation + np.array([0.0, 0.0, LIFT_CLEAR]))
+        return self.context.robot.whole_body.reach(self.params.side, target, move_base=False, tolerance=CARRY_TOLERANCE)

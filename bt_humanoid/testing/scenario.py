@@ -63,7 +63,8 @@ def build_run(
     """
     spec = load_mission(mission)
     header = spec.header
-    stack = RobotStack.load(header.world, header.robot, header.seed if seed is None else seed, robot_start)
+    seed = header.seed if seed is None else seed
+    stack = RobotStack.load(header.world, header.robot, seed, robot_start, scene=spec.scene)
     return MissionRun(stack, spec)
 
 

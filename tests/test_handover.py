@@ -1,0 +1,78 @@
+"""Handing things to a person who takes them: their arm reaches, their fingers close, the robot feels the pull."""
+
+import math
+
+import numpy as np
+import pytest
+
+from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
+from bt_humanoid.testing.scenario import Scenario, build_run
+
+NEAR_THE_PERSON = (0.32, -2.4, 180.0)  # the kitchen's person stands at (-0.6, -2.4): arm's length from the robot
+
+
+@pytest.mark.parametrize("reach, height", [(0.3, 0.9), (0.45, 1.0), (0.6, 1.2), (0.25, 0.8)])
+def test_the_person_s_arm_puts_the_wrist_where_asked_with_the_hand_level(reach: float, height: float):
+    shoulder, elbow, wrist = arm_angles(reach, height)
+    # positive angles turn down: each link points (cos a, -sin a) in (forward, up)
+    forward = SHOULDER_OUT + UPPER_ARM * math.cos(shoulder) + FOREARM * math.cos(shoulder + elbow)
+    up = SHOULDER_HEIGHT - UPPER_ARM * math.sin(shoulder) - FOREARM * math.sin(shoulder + elbow)
+    assert (forward, up) == pytest.approx((reach, height), abs=1e-9)
+    assert shoulder + elbow + wrist == pytest.approx(0.0)
+    assert elbow < 0  # the elbow below the line from shoulder to wrist, as people hold their arms
+
+
+def _hand_over(takes: bool = True, timeout: float = 20.0) -> Scenario:
+    mission = {
+        "mission": "hand it over",
+        "world": "kitchen",
+        "scene": "holding_coke",
+        "tree": {"give": {"to": "person", "timeout": timeout}},
+        "success": [{"delivered": "coke"}],
+    }
+    run = build_run(mission, robot_start=NEAR_THE_PERSON)
+    run.sim.people["person"].takes = takes
+    hands = run.truth.hand_geoms()
+    person = np.isin(run.sim.model.geom_bodyid, sorted(run.truth.people_bodies()))
+    robot = np.isin(run.sim.model.geom_bodyid, sorted(run.sim.robot_bodies))
+    touched: list[float] = []  # the robot on the person, anywhere but hand on hand
+
+    def watch() -> None:
+        g1, g2 = run.sim.data.contact.geom1, run.sim.data.contact.geom2
+        touching = (person[g1] & robot[g2]) | (person[g2] & robot[g1])
+        if np.any(touching & ~(hands[g1] & hands[g2])):
+            touched.append(run.sim.time)
+
+    person_state: list[tuple[str | None, str]] = []  # (the robot's hand on the coke, what the person is doing)
+    run.executor.observers.append(watch)
+    run.executor.observers.append(
+        lambda: person_state.append((run.truth.in_hand("coke"), run.sim.people["person"].state))
+    )
+    scenario = Scenario(run, run.execute())
+    scenario.touched = touched  # type: ignore[attr-defined]
+    scenario.person_state = person_state  # type: ignore[attr-defined]
+    return scenario
+
+
+@pytest.mark.sim
+def test_the_person_takes_the_coke_and_the_robot_lets_go_when_it_feels_the_pull():
+    scenario = _hand_over()
+    assert scenario.result.summary()["outcome"] == "success", scenario.result.summary()
+    assert scenario.truth.held_by_person("coke") == "person"
+    assert scenario.truth.in_hand("coke") is None
+    assert scenario.truth.object_position("coke")[2] > 0.8, "in their hand, not on the floor"
+    states = scenario.person_state  # type: ignore[attr-defined]
+    let_go = next(i for i, (hand, _) in enumerate(states) if hand is None)
+    assert states[let_go][1] in ("closing", "pulling"), "let go once their fingers were on it, not before"
+    assert not scenario.touched  # type: ignore[attr-defined]
+    assert "Please take the coke." not in scenario.run.stack.said, "taken before it had to ask"
+
+
+@pytest.mark.sim
+def test_a_busy_person_is_asked_and_the_robot_keeps_what_they_do_not_take():
+    scenario = _hand_over(takes=False, timeout=4.0)
+    assert scenario.result.summary()["outcome"] == "failure"
+    assert "person did not take the coke in 4 s; still holding it" in scenario.result.summary()["cause"]
+    assert "Please take the coke." in scenario.run.stack.said
+    assert scenario.truth.in_hand("coke") == "right"
+    assert scenario.truth.held_by_person("coke") is None
