@@ -1,10 +1,8 @@
 """Typed commands in the kitchen, end to end: the learned detector tells a coke from five other cans."""
 
-import numpy as np
 import pytest
 
 from bt_humanoid.cli import EXIT_OK, run_main
-from bt_humanoid.engine.verdict import HANDOVER_REACH
 
 
 @pytest.mark.sim
@@ -26,9 +24,7 @@ def test_bring_me_a_coke_brings_the_coke_not_another_can(monkeypatch, capsys):
     from bt_humanoid.sim.ground_truth import GroundTruth
 
     truth = GroundTruth(sim)
-    person = truth.person_position("person")
-    coke = truth.object_position("coke")
-    assert np.hypot(*(coke[:2] - person[:2])) <= HANDOVER_REACH  # handed over: let go within the person's reach
+    assert truth.held_by_person("coke") == "person"  # handed over: in the person's hand
     for other in ("pepsi", "7up", "red bull", "lime soda", "grapefruit soda"):
         assert truth.rests_on(other, "table") and truth.upright(other), f"the {other} was moved"
 

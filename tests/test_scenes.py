@@ -228,7 +228,7 @@ def test_a_coke_held_from_the_start_is_handed_to_the_person(kitchen, blind):
         tree:
           sequence:
             - navigate: {person: person}
-            - give: {to: person, timeout: 2}
+            - give: {to: person}
         success:
           - delivered: coke
         """,

@@ -32,8 +32,11 @@ SHOULDER_HEIGHT = 1.35  # m above the floor
 SHOULDER_OUT = 0.18  # m from the body's axis, towards where the arm points
 UPPER_ARM, FOREARM = 0.3, 0.27  # m
 PALM_DEPTH = 0.03  # m from the wrist to the palm's front
-FINGER_LENGTH = 0.12  # m ahead of the palm: past the middle of a thing held by its near and far faces
-FINGER_OPEN = 0.06  # m each finger's inner face stands from the hand's middle when open
+FINGER_LENGTH = 0.11  # m ahead of the palm
+FINGER_OPEN = 0.06  # m each fingertip's inner face stands from the hand's middle when open
+# the fingertips, 3 cm long, stand proud of the fingers by 1.2 cm, this far ahead of the palm: they meet the thing
+# at its middle, and the rest of the finger passes the robot's fingers on its near and far faces
+TIP_AT, TIP_LENGTH, TIP_DEPTH = 0.08, 0.03, 0.012
 # m from the body's axis, horizontally, where they reach for a thing: held out to them, not carried past (a robot
 # that stops at arm's length, 0.6 m from its footprint, carries things 0.59 m from them and holds them out at 0.42)
 REACH = (0.3, 0.5)
@@ -44,7 +47,6 @@ HAND_SPEED = 0.3  # m/s their hand moves at ...
 TURN_RATE = 1.5  # rad/s ... and turns at
 TURNED = 0.05  # rad: the arm turns to the thing first, low, to within this ...
 APPROACH = 0.12  # m ... then the hand comes level with the thing this far back, then slides round it
-GRIP_BEHIND = 0.035  # m between the palm and the thing: room for the robot's finger on its near face, and 2 cm more
 CLOSE_TIME = 0.5  # s the fingers take to close before the pull
 PULL = np.array([-0.06, 0.03])  # m: (towards themselves, up) the hand draws a taken thing, slowly ...
 PULL_SPEED = 0.05  # m/s
@@ -65,7 +67,7 @@ def arm_joint_names(person: str) -> list[str]:
 
 
 def finger_names(person: str) -> list[str]:
-    """Each finger's body, joint, actuator and geom (one name for all four)."""
+    """Each finger's body, joint, actuator and fingertip geom (one name for all four)."""
     return [f"{person}_finger_{side}" for side in ("left", "right")]
 
 
@@ -101,9 +103,13 @@ def add_arm(spec: mujoco.MjSpec, person: str) -> None:
             range=[0, FINGER_OPEN], damping=5,
         )  # fmt: skip
         finger.add_geom(
-            name=f"{person}_finger_{side}", type=mujoco.mjtGeom.mjGEOM_BOX, size=[FINGER_LENGTH / 2, 0.006, 0.015],
-            pos=[FINGER_LENGTH / 2, sign * (FINGER_OPEN + 0.006), 0], mass=0.05, rgba=skin,
-            friction=[1.0, 0.02, 0.001], condim=4, priority=1,
+            name=f"{person}_finger_{side}", type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[TIP_LENGTH / 2, TIP_DEPTH / 2, 0.015], pos=[TIP_AT, sign * (FINGER_OPEN + TIP_DEPTH / 2), 0],
+            mass=0.01, rgba=skin, friction=[1.0, 0.02, 0.001], condim=4, priority=1,
+        )  # fmt: skip
+        finger.add_geom(
+            name=f"{person}_finger_{side}_bar", type=mujoco.mjtGeom.mjGEOM_BOX, size=[FINGER_LENGTH / 2, 0.003, 0.012],
+            pos=[FINGER_LENGTH / 2, sign * (FINGER_OPEN + TIP_DEPTH + 0.003), 0], mass=0.04, rgba=skin,
         )  # fmt: skip
         actuator = spec.add_actuator(name=f"{person}_finger_{side}", target=f"{person}_finger_{side}")
         actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
@@ -271,27 +277,24 @@ class PersonDriver:
         offset = centre[:2] - self.data.xpos[self.body][:2]
         if not REACH[0] - 0.1 <= float(np.hypot(*offset)) <= REACH[1] + 0.1:
             return None
-        inwards, half = self._face(body, offset / max(float(np.hypot(*offset)), 1e-9))
-        wrist = centre[:2] - (half + GRIP_BEHIND + PALM_DEPTH) * inwards
+        inwards = self._face(body, offset / max(float(np.hypot(*offset)), 1e-9))
+        wrist = centre[:2] - (TIP_AT + PALM_DEPTH) * inwards  # the fingertips either side of its middle
         from_axis = wrist - self.data.xpos[self.body][:2]
         yaw = math.atan2(from_axis[1], from_axis[0])
         turn = math.remainder(math.atan2(inwards[1], inwards[0]) - yaw, 2 * math.pi)
         return HandPose(yaw, float(np.hypot(*from_axis)), float(centre[2]), turn)
 
-    def _face(self, body: int, towards: np.ndarray) -> tuple[np.ndarray, float]:
-        """The thing's face the hand squares up to, as the unit direction into it, and its half-depth that way:
-        of a box, the side most nearly facing them; of anything round, the way they look at it."""
+    def _face(self, body: int, towards: np.ndarray) -> np.ndarray:
+        """The unit direction into the thing the hand squares up to: of a box, its side most nearly facing them;
+        of anything round, the way they look at it."""
         geoms = np.flatnonzero(self.model.geom_bodyid == body)
-        boxes = [g for g in geoms if self.model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
-        if len(boxes) == len(geoms) == 1:
-            axes = self.data.geom_xmat[boxes[0]].reshape(3, 3)[:2, :2].T  # the box's x and y axes, on the floor
-            sizes = self.model.geom_size[boxes[0]][:2]
-            dots = axes @ towards
-            best = int(np.argmax(np.abs(dots)))
-            inwards = axes[best] * np.sign(dots[best])
-            return inwards / max(float(np.hypot(*inwards)), 1e-9), float(sizes[best])
-        round_ = [g for g in geoms if self.model.geom_type[g] != mujoco.mjtGeom.mjGEOM_BOX]
-        return towards, float(max((self.model.geom_size[g][0] for g in round_ or geoms), default=0.03))
+        if len(geoms) != 1 or self.model.geom_type[geoms[0]] != mujoco.mjtGeom.mjGEOM_BOX:
+            return towards
+        axes = self.data.geom_xmat[geoms[0]].reshape(3, 3)[:2, :2].T  # the box's x and y axes, on the floor
+        dots = axes @ towards
+        best = int(np.argmax(np.abs(dots)))
+        inwards = axes[best] * np.sign(dots[best])
+        return inwards / max(float(np.hypot(*inwards)), 1e-9)
 
     def _move_towards(self, goal: HandPose) -> bool:
         """Step the hand's set point towards ``goal``: arrived, and the wrist with it?"""

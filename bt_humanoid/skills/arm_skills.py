@@ -91,12 +91,12 @@ class GiveParams(StrictModel):
     release_key: str = Field("release", description="blackboard key that, once true, means 'let go now'")
 
 
-@skill(
-    "give",
-    "hold the object out to a person; let go when they take it (the wrist feels the pull) or when asked "
-    "(blackboard); ask them half-way through the wait, and keep holding it if they never do",
-)
+@skill("give", "hold the object out to a person; let go when they take it (felt at the wrist) or when asked")
 class Give(_ManipulationSkill):
+    """Hand the held object to a person. It is let go when the wrist's force sensor feels them take it (their pull,
+    or their hand taking its weight), or when the blackboard's ``release_key`` says so; half-way through the
+    timeout the robot asks them to take it, and at the end it fails still holding it: never dropped."""
+
     Params = GiveParams
 
     @classmethod
