@@ -38,3 +38,10 @@ def _geom_extents(model: mujoco.MjModel, geom: int) -> tuple[np.ndarray, np.ndar
         body = model.body(int(model.geom_bodyid[geom])).name
         raise ValueError(f"object body {body!r}: unsupported geom type {kind}")
     return pos - half, pos + half
+
+
+def geoms_touching(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> set[int]:
+    """The geoms in contact with ``body`` now."""
+    geom1, geom2 = data.contact.geom1[: data.ncon], data.contact.geom2[: data.ncon]
+    bodies1, bodies2 = model.geom_bodyid[geom1], model.geom_bodyid[geom2]
+    return set(geom2[bodies1 == body].tolist()) | set(geom1[bodies2 == body].tolist())

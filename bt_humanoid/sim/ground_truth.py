@@ -11,7 +11,7 @@ import math
 import mujoco
 import numpy as np
 
-from bt_humanoid.sim.geometry import object_extents, rotation_of
+from bt_humanoid.sim.geometry import geoms_touching, object_extents, rotation_of
 from bt_humanoid.sim.people import finger_names, person_hand
 from bt_humanoid.sim.simulation import Simulation
 
@@ -78,14 +78,7 @@ class GroundTruth:
         return touching
 
     def geoms_in_contact(self, body: int) -> set[int]:
-        touching = set()
-        for contact in self.data.contact[: self.data.ncon]:
-            g1, g2 = contact.geom1, contact.geom2
-            if self.model.geom_bodyid[g1] == body:
-                touching.add(int(g2))
-            elif self.model.geom_bodyid[g2] == body:
-                touching.add(int(g1))
-        return touching
+        return geoms_touching(self.model, self.data, body)
 
     def rests_on(self, obj: str, surface: str) -> bool:
         """The object touches the surface's top geom, lies above it and is (nearly) still."""

@@ -2,17 +2,17 @@
 
 The arm is built onto the person's body in the world's model (``add_arm``): a yaw at the body's axis (they turn
 to what is offered), a shoulder, an elbow, a wrist that keeps the hand level and one that turns it square to the
-thing, each a position servo with a
-person's strength; the hand is a palm with two flat fingers that close sideways on a thing. The arm's own weight
-is carried by gravity compensation (muscles hold an arm up without thought); what it holds, it must lift.
+thing, each a position servo with a person's strength; the hand is a palm with two fingers whose tips close
+sideways on a thing. The arm's own weight is carried by gravity compensation (muscles hold an arm up without
+thought); what it holds, it must lift.
 
 The script (``PersonDriver``), every control step:
 
 1. waits, arm down, until the robot holds something out to them, still, within their reach (the scene's script
    reads what the person would see: a thing touched by the robot alone, held out close to them, not moving);
 2. reaches round it: the arm turns to it, low; the open hand comes level with the thing's middle from their side,
-   then slides forward, fingers either side of it (the robot's parallel fingers hold it on the faces towards and
-   away from the person, so the sides are free);
+   then slides forward, fingertips either side of its middle (the robot's parallel fingers hold it on the faces
+   towards and away from the person, so the sides are free);
 3. closes the fingers on it, then draws it a little up and towards themselves: a pull the robot's wrist feels;
 4. once the robot has let go and drawn its hand back, holds it close. A thing that falls out of their hand, they
    leave.
@@ -27,6 +27,8 @@ from typing import NamedTuple
 
 import mujoco
 import numpy as np
+
+from bt_humanoid.sim.geometry import geoms_touching
 
 SHOULDER_HEIGHT = 1.35  # m above the floor
 SHOULDER_OUT = 0.18  # m from the body's axis, towards where the arm points
@@ -51,7 +53,7 @@ CLOSE_TIME = 0.5  # s the fingers take to close before the pull
 PULL = np.array([-0.06, 0.03])  # m: (towards themselves, up) the hand draws a taken thing, slowly ...
 PULL_SPEED = 0.05  # m/s
 HOLD = np.array([0.2, 1.0])  # m: (wrist from the body's axis, height) where they hold what they took ...
-WAIT_CLEAR = 1.5  # s ... drawn in once the robot's hand has had this long to withdraw (its finger is on their side)
+WAIT_CLEAR = 1.5  # s ... once the robot's hand has had this long to withdraw (its finger is on their side)
 ARM_GAINS = {
     "yaw": (150.0, 40.0),
     "shoulder": (300.0, 50.0),
@@ -260,11 +262,7 @@ class PersonDriver:
         return name is not None and bool(self._touching(self.objects[name]) & self.robot_geoms)
 
     def _touching(self, body: int) -> set[int]:
-        """The geoms in contact with ``body``."""
-        contacts = self.data.contact
-        geom1, geom2 = contacts.geom1[: self.data.ncon], contacts.geom2[: self.data.ncon]
-        bodies1, bodies2 = self.model.geom_bodyid[geom1], self.model.geom_bodyid[geom2]
-        return set(geom2[bodies1 == body].tolist()) | set(geom1[bodies2 == body].tolist())
+        return geoms_touching(self.model, self.data, body)
 
     # --------------------------------------------------------------------------- where the hand goes
 
