@@ -97,3 +97,9 @@ def test_crossing_the_walking_persons_loop_never_touches_them(yields: float):
     assert not contacts
     x, y, _ = scenario.truth.robot_pose()
     assert math.hypot(x - 7.0, y - 2.4) <= 0.05
+
+
+def test_a_walker_expects_what_they_saw_moving_to_go_on_moving():
+    seen = Sighting(1.0, np.array([[5.0, 0.0]]), np.array([0.1]), np.array([[-0.5, 0.0]]))
+    assert np.allclose(seen.predicted(1.7).parts, [[4.65, 0.0]]), "0.7 s on at 0.5 m/s"
+    assert seen.predicted(1.7).radii is seen.radii

@@ -3,7 +3,8 @@
 A walker heads for the next corner of their loop at their walking speed and reacts to the robot as they see it:
 
 - they see the parts of the robot that are in their field of view and not hidden behind something (a ray from
-  their eyes to each part, ten looks a second), and act on what they saw one reaction time ago;
+  their eyes to each part, ten looks a second), and act on what they saw one reaction time ago, carried forward
+  at the speed they saw it move (people expect a moving thing to go on moving);
 - when they meet the robot, they either yield (stop while it is close in front of them, and turn back if it stays)
   or walk round it at a small gap and go on: drawn once per meeting from the run's seed (``Walker.yields``);
 - a robot they have not seen yet, they do not avoid: keeping apart from them is then the robot's job (its speed and
@@ -37,15 +38,25 @@ LOOK_AHEAD = 1.0  # m of their way that must pass it at that gap for one who wal
 SWERVES = np.radians([0, -10, 10, -20, 20, -30, 30, -45, 45, -60, 60, -75, 75, -90, 90])  # keep right, like people
 PART_RADIUS = (0.05, 0.4)  # m: the smallest and largest disc a part of the robot is seen as
 PATIENCE = 3.0  # s a walker waits for the robot before turning back
+MAX_SPEED = 2.0  # m/s: no part of the robot is expected to move faster
 
 
 @dataclass
 class Sighting:
-    """What a walker saw of the robot at one look: its parts as discs on the floor (none: not seen)."""
+    """What a walker saw of the robot at one look: its parts as discs on the floor (none: not seen), and how fast
+    each moved since the look before."""
 
     time: float
     parts: np.ndarray  # (n, 2) centres, m
     radii: np.ndarray  # (n,) m
+    velocities: np.ndarray | None = None  # (n, 2) m/s; none: not seen moving
+    bodies: np.ndarray | None = None  # (n,) which of the robot's bodies each part is
+
+    def predicted(self, now: float) -> Sighting:
+        """Where what they saw will be ``now``, had it gone on as it moved: people expect a moving thing to move."""
+        if self.velocities is None:
+            return self
+        return Sighting(now, self.parts + self.velocities * (now - self.time), self.radii)
 
 
 class WalkerDriver:
@@ -98,7 +109,7 @@ class WalkerDriver:
         if now >= self.next_look:
             self.sightings.append(self.look(here, heading))
             self.next_look = now + LOOK_PERIOD
-        seen = self.picture(now)
+        seen = self.picture(now).predicted(now)
         self._meet(now, here, heading, seen)
         if self.yielding:
             way = heading if self._clear(here, heading[None, :], seen, YIELD_AHEAD)[0] else None
@@ -129,7 +140,17 @@ class WalkerDriver:
         )  # fmt: skip
         hit = self._geoms >= 0
         seen = in_view & hit & self._is_robot[self.model.geom_bodyid[np.where(hit, self._geoms, 0)]]
-        return Sighting(float(self.data.time), self.data.xpos[self.robot_parts[seen], :2].copy(), self.part_radii[seen])
+        now, parts = float(self.data.time), self.data.xpos[self.robot_parts[seen], :2].copy()
+        velocities = np.zeros_like(parts)
+        last = self.sightings[-1] if self.sightings else None
+        if last is not None and last.bodies is not None and now - last.time <= 2 * LOOK_PERIOD:
+            before = dict(zip(last.bodies.tolist(), last.parts, strict=True))
+            for i, body in enumerate(self.robot_parts[seen].tolist()):
+                if body in before:
+                    velocities[i] = (parts[i] - before[body]) / max(now - last.time, 1e-9)
+        return Sighting(
+            now, parts, self.part_radii[seen], np.clip(velocities, -MAX_SPEED, MAX_SPEED), self.robot_parts[seen]
+        )
 
     def picture(self, now: float) -> Sighting:
         """What they act on now: the last look at least one reaction time old (before any: nothing seen)."""
