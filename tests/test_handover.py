@@ -2,9 +2,9 @@
 
 import math
 
-import numpy as np
 import pytest
 
+from bt_humanoid.evaluation.episode import watch_people
 from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
 from bt_humanoid.testing.scenario import Scenario, build_run
 
@@ -32,19 +32,8 @@ def _hand_over(takes: bool = True, timeout: float = 20.0) -> Scenario:
     }
     run = build_run(mission, robot_start=NEAR_THE_PERSON)
     run.sim.people["person"].takes = takes
-    hands = run.truth.hand_geoms()
-    person = np.isin(run.sim.model.geom_bodyid, sorted(run.truth.people_bodies()))
-    robot = np.isin(run.sim.model.geom_bodyid, sorted(run.sim.robot_bodies))
-    touched: list[float] = []  # the robot on the person, anywhere but hand on hand
-
-    def watch() -> None:
-        g1, g2 = run.sim.data.contact.geom1, run.sim.data.contact.geom2
-        touching = (person[g1] & robot[g2]) | (person[g2] & robot[g1])
-        if np.any(touching & ~(hands[g1] & hands[g2])):
-            touched.append(run.sim.time)
-
+    touched = watch_people(run, run.stack)  # the robot on the person, anywhere but hand on hand, as bt-eval counts
     person_state: list[tuple[str | None, str]] = []  # (the robot's hand on the coke, what the person is doing)
-    run.executor.observers.append(watch)
     run.executor.observers.append(
         lambda: person_state.append((run.truth.in_hand("coke"), run.sim.people["person"].state))
     )

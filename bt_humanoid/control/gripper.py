@@ -7,6 +7,8 @@ stops the fingers and is held by friction. The result says which happened.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from bt_humanoid.control.joint_motion import JointReferenceController
@@ -64,7 +66,7 @@ class GripperController:
         config = self.grippers[side]
         idx = self.joints.indices(config.joints)
         now = self.joints.io.positions()[idx]
-        step = (config.open - config.closed) / max(abs(config.open - config.closed), 1e-9) * by / len(idx)
+        step = math.copysign(by / len(idx), config.open - config.closed)  # each finger's share, towards open
         targets = np.clip(now + step, min(config.open, config.closed), max(config.open, config.closed))
         return self.joints.move(dict(zip(config.joints, targets.tolist(), strict=True)))
 

@@ -12,7 +12,7 @@ import mujoco
 import numpy as np
 
 from bt_humanoid.sim.geometry import geoms_touching, object_extents, rotation_of
-from bt_humanoid.sim.people import finger_names, person_hand
+from bt_humanoid.sim.people import person_hand
 from bt_humanoid.sim.simulation import Simulation
 
 UPRIGHT_TOLERANCE_DEG = 15.0
@@ -100,12 +100,9 @@ class GroundTruth:
         return bool(math.degrees(math.acos(np.clip(z_axis[2], -1, 1))) < UPRIGHT_TOLERANCE_DEG)
 
     def held_by_person(self, obj: str) -> str | None:
-        """The person (world.yaml's name) whose two fingers both touch the object, else None."""
-        touching = {self.model.geom(g).name for g in self.geoms_in_contact(self._object_body(obj))}
-        for name, person in self.sim.world.people.items():
-            if set(finger_names(person.body)) <= touching:
-                return name
-        return None
+        """The person (world.yaml's name) whose two fingertips are both on the object, else None."""
+        body = self._object_body(obj)
+        return next((name for name, person in self.sim.people.items() if person.holding(body)), None)
 
     def in_hand(self, obj: str) -> str | None:
         """The side whose two finger pads both touch the object, else None."""

@@ -188,20 +188,19 @@ class PersonDriver:
         self.still_since: dict[str, float] = {}
         self.hand = REST  # where the hand is told to be now
         self.since = 0.0  # s: when this state began
+        self.last_control, self.dt = float(self.data.time), 0.0  # s: the hand's set point moves by the time since
         self._command(open_hand=True)
         self.data.qpos[self.arm_qpos] = self.data.ctrl[self.arm]  # initial conditions: the arm starts at rest
 
-    def holds(self) -> str | None:
-        """The thing both their fingers touch (ground truth; what ``delivered`` means)."""
-        for name, body in self.objects.items():
-            if self.finger_geoms <= self._touching(body):
-                return name
-        return None
+    def holding(self, body: int) -> bool:
+        """Are both their fingertips on ``body``? (Ground truth; what ``delivered`` means.)"""
+        return self.finger_geoms <= self._touching(body)
 
     def control(self) -> None:
         if not self.takes:
             return
         now = float(self.data.time)
+        self.dt, self.last_control = now - self.last_control, now
         if self.state == "waiting":
             self.target = self._offered(now)
             if self.target is not None:
@@ -220,7 +219,7 @@ class PersonDriver:
         elif self.state == "holding":
             if now - self.since > WAIT_CLEAR:
                 self._move_towards(self.hand._replace(reach=HOLD[0], height=HOLD[1]))
-            if self.holds() != self.target:
+            if self.target is None or not self.holding(self.objects[self.target]):
                 self._enter("waiting", now)  # it fell out of their hand: they leave it
         self._command(open_hand=self.state in ("waiting", "turning", "approaching", "reaching"))
 
@@ -300,9 +299,9 @@ class PersonDriver:
         return self.hand == goal and self._wrist_error() < 0.01
 
     def _step(self, goal: HandPose, speed: float) -> HandPose:
-        """One control period of the hand's set point towards ``goal``: at ``speed`` (m/s), turning at TURN_RATE."""
-        dt = float(self.model.opt.timestep) * 5  # the control period (the caller's rate, 10 ms)
-        hand = self.hand
+        """The hand's set point, one control period (``dt``) on towards ``goal``: at ``speed`` (m/s), turning at
+        TURN_RATE."""
+        dt, hand = self.dt, self.hand
 
         def turned(now: float, to: float) -> float:
             step = math.remainder(to - now, 2 * math.pi)

@@ -160,7 +160,10 @@ class Give(_ManipulationSkill):
             self.still.append(force)
         elif force is not None and self.still:
             change = float(np.linalg.norm(force - np.mean(self.still, axis=0)))
-            self.pulled_since = (self.pulled_since or now) if change > PULL else None
+            if change <= PULL:
+                self.pulled_since = None
+            elif self.pulled_since is None:
+                self.pulled_since = now
             if self.pulled_since is not None and now - self.pulled_since >= PULL_FOR:
                 self.motion.succeed(f"{p.to} took it: the wrist felt {change:.1f} N")
                 return
