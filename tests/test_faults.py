@@ -95,3 +95,18 @@ def test_a_new_command_mid_mission_stops_the_robot_and_is_done_instead():
 def test_the_suite_takes_fault_kinds_in_turn(kind):
     suite, _ = load_suite(Path(SUITE))
     assert suite.faults.kinds[Draw(suite, KINDS.index(kind)).fault_index].kind == kind
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+def test_a_bottle_that_slips_but_stays_caught_in_the_pads_is_set_down_and_grasped_afresh():
+    # the fetch suite's episode 147: the wet bottle slides down between the pads and is caught at another width;
+    # carried like that it once went round the flat, held, while the robot searched the rooms for it
+    fetch = str(Path(SUITE).with_name("fetch.yaml"))
+    events: list[dict] = []
+    record = run_episode(fetch, 147, events=events)
+    assert record["fault"] == "slip" and record["fault_fired"]
+    askew = [m for m in _failures(events) if "slipped in the right hand" in m]
+    assert askew and "set it down to grasp it afresh" in askew[0], _failures(events)
+    assert record["success"], record["failure"]
+    assert record["person_contacts"] == 0 and not record["collision"]

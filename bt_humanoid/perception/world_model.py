@@ -40,6 +40,7 @@ class TrackedObject:
     yaw_known: bool = True  # false while a mug's handle has not been seen (its yaw is a guess)
     votes: Counter = field(default_factory=Counter)  # (kind, colour, identity) → sightings, when perception tracks it
     identity: str | None = None  # which of the world's objects it is ("coke"), where its look tells them apart
+    seen_from: float = 0.0  # m from the camera of the nearest view its position comes from (0: not from a camera)
 
     @property
     def bottom(self) -> float:

@@ -397,8 +397,17 @@ class Grasp(_ManipulationSkill):
             ("weigh", self._unless_held(self._weigh)),
             ("lift", self._unless_held(self._lift)),
             ("verify", self._unless_held(self._verify)),
+            # held askew (slid down to a bottle's neck, turned in the pads): set it down where it was taken from
+            ("set it down again", self._if_askew(self._set_down_askew)),
+            ("let go of it", self._if_askew(lambda: self.context.robot.grippers.command(self.params.side, "open"))),
+            ("clear it", self._if_askew(self._clear_askew)),
+            ("grasp it afresh", self._if_askew(self._fail_askew)),
             ("carry", self._carry_taken),
         ]
+
+    def _if_askew(self, phase: Callable[[], MotionHandle | None]) -> Callable[[], MotionHandle | None]:
+        """A phase that runs only when the verify found the object held, but not as it was grasped."""
+        return lambda: phase() if self.askew else None
 
     def _unless_held(self, phase: Callable[[], MotionHandle | None]) -> Callable[[], MotionHandle | None]:
         """A phase that is skipped when the hand already holds the object (a retry after the carry failed)."""
@@ -455,7 +464,7 @@ class Grasp(_ManipulationSkill):
     def _plan(self) -> None:
         side = self.params.side
         held = self.context.world_model.held(side)
-        self._held_already, self.surface = False, None
+        self._held_already, self.surface, self.askew = False, None, False
         if held is not None and held.id == self._object(self.params.object).id:
             self._held_already = True  # taken already (a carry that fell short): only the carry is left to do
             return
@@ -562,18 +571,51 @@ class Grasp(_ManipulationSkill):
         (a bag of chips) is caught tilted, a centimetre wider, and hangs straight once it is off the surface.
         """
         grippers = self.context.robot.grippers
-        width = grippers.width(self.params.side)
-        if not grippers.holding(self.params.side) or abs(width - self.grasp.width) > GRASP_WIDTH_TOLERANCE:
+        if not grippers.holding(self.params.side):
             self.target.held_by = None
             self.target.confidence = 0.0  # where it went is unknown until it is seen again
             raise PhaseFailure(f"the {self.target.name} slipped out of the {self.params.side} hand")
+        self.width_held = grippers.width(self.params.side)
+        if abs(self.width_held - self.grasp.width) > GRASP_WIDTH_TOLERANCE:
+            self.askew = True  # something is still between the pads: carried like this it would fall, or be put crooked
+            return
         self._weigh()  # again, held still and clear of everything: the better reading
         # reached: wherever it is put next, its stance starts afresh
         self.target.step_to = None
 
+    def _set_down_askew(self) -> MotionHandle:
+        """Lower the hand to where it closed, stopping as soon as what it holds meets the surface."""
+        return self.context.robot.whole_body.reach(
+            self.params.side,
+            self._pose(self.grasp.position),
+            speed=DESCEND_SPEED / 2,
+            limits=self._keepout(self.surface.region),
+            stop_on_contact=True,
+            tolerance=(0.008, 0.1),
+        )
+
+    def _clear_askew(self) -> MotionHandle:
+        """Straight up, clear of its top, so the next look sees it and the next grasp starts from above."""
+        self.target.held_by = None
+        self.target.confidence = 0.0  # where it stands now is for the camera to say
+        hand = self._hand_xyz(self.params.side)
+        return self.context.robot.whole_body.reach(
+            self.params.side,
+            self._pose(hand + np.array([0.0, 0.0, LIFT_HEIGHT])),
+            speed=DESCEND_SPEED,
+            move_base=False,
+            tolerance=CARRY_TOLERANCE,
+        )
+
+    def _fail_askew(self) -> None:
+        raise PhaseFailure(
+            f"the {self.target.name} slipped in the {self.params.side} hand (held {self.width_held * 100:.1f} cm "
+            f"wide, grasped at {self.grasp.width * 100:.1f} cm): set it down to grasp it afresh"
+        )
+
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt
-        if self.phase in ("descend", "close"):
+        if self.phase in ("descend", "close", "set it down again"):
             self.context.robot.grippers.command(self.params.side, "open")
         if self.phase == "descend":
             self._note_short_reach(self.target, self.grasp.position)
