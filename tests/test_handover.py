@@ -5,8 +5,12 @@ import math
 import pytest
 
 from bt_humanoid.evaluation.episode import watch_people
+from bt_humanoid.language.embedded import EmbeddedPlanner
+from bt_humanoid.sim.scene_config import load_scene
+from bt_humanoid.sim.world_config import load_world_config
 from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
 from bt_humanoid.testing.scenario import Scenario, build_run
+from bt_humanoid.testing.told import told_planning_context
 
 NEAR_THE_PERSON = (0.32, -2.4, 180.0)  # the kitchen's person stands at (-0.6, -2.4): arm's length from the robot
 
@@ -22,12 +26,12 @@ def test_the_person_s_arm_puts_the_wrist_where_asked_with_the_hand_level(reach: 
     assert elbow < 0  # the elbow below the line from shoulder to wrist, as people hold their arms
 
 
-def _hand_over(takes: bool = True, timeout: float = 20.0) -> Scenario:
+def _hand_over(takes: bool = True, timeout: float = 20.0, tree: dict | None = None) -> Scenario:
     mission = {
         "mission": "hand it over",
         "world": "kitchen",
         "scene": "holding_coke",
-        "tree": {"give": {"to": "person", "timeout": timeout}},
+        "tree": tree or {"give": {"to": "person", "timeout": timeout}},
         "success": [{"delivered": "coke"}],
     }
     run = build_run(mission, robot_start=NEAR_THE_PERSON)
@@ -65,3 +69,21 @@ def test_a_busy_person_is_asked_and_the_robot_keeps_what_they_do_not_take():
     assert "Please take the coke." in scenario.run.stack.said
     assert scenario.truth.in_hand("coke") == "right"
     assert scenario.truth.held_by_person("coke") is None
+
+
+@pytest.mark.sim
+def test_what_a_busy_person_does_not_take_is_put_down_on_the_surface_nearest_them():
+    # the hand-over "bring me the coke" plans: with a free spot on the surface nearest the person
+    context = told_planning_context("kitchen", load_scene(load_world_config("kitchen"), "holding_coke"))
+    plan = EmbeddedPlanner().plan("bring me the coke", context)
+    hand_over = plan.mission["tree"]["sequence"][-1]["hand_over"]
+    assert hand_over["surface"] == "table"
+    scenario = _hand_over(takes=False, tree={"hand_over": {**hand_over, "timeout": 4.0}})
+    said = scenario.run.stack.said
+    assert "Please take the coke." in said
+    assert "You did not take it, so I put it on the table." in said
+    assert scenario.truth.in_hand("coke") is None and scenario.truth.held_by_person("coke") is None
+    assert scenario.truth.rests_on("coke", "table"), "put down, not dropped"
+    assert scenario.truth.upright("coke")
+    assert scenario.result.summary()["outcome"] == "failure", scenario.result.summary()  # the person has not got it
+    assert not scenario.touched  # type: ignore[attr-defined]

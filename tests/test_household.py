@@ -6,6 +6,7 @@ where the scene puts them), which needs no camera and no stepping.
 
 from functools import cache
 
+import numpy as np
 import pytest
 
 from bt_humanoid.errors import UserError
@@ -193,7 +194,26 @@ def test_household_requests_plan_what_they_ask(scene, say, expect):
 def test_a_held_thing_is_not_taken_again():
     plan = EmbeddedPlanner().plan("bring me a coke", _context("holding_coke"))
     kinds = [next(iter(step)) for step in plan.mission["tree"]["sequence"]]
-    assert kinds == ["navigate", "give"] and "pick up" not in plan.say
+    assert kinds == ["navigate", "hand_over"] and "pick up" not in plan.say
+
+
+def test_a_hand_over_names_a_free_spot_on_the_surface_nearest_the_person_for_when_it_is_not_taken():
+    context = _context("default")
+    plan = EmbeddedPlanner().plan("bring me the coke", context)
+    hand_over = plan.mission["tree"]["sequence"][-1]["hand_over"]
+    person = context.belief.person(hand_over["to"])[:2]
+    surfaces = context.world.surfaces
+    distance = {
+        name: float(np.hypot(*(np.array(context.world.places[s.place].pose[:2]) - person)))
+        for name, s in surfaces.items()
+    }
+    assert hand_over["surface"] == min(distance, key=distance.get)
+    assert hand_over["place"] == surfaces[hand_over["surface"]].place
+    assert context.belief.surface(hand_over["surface"]).contains(np.array([hand_over["x"], hand_over["y"]]))
+    # judged as meant: in the person's hand
+    start = scene_situation(load_scene(KITCHEN, "default"), KITCHEN)
+    end = plan_situation(plan.mission["tree"], start, KITCHEN)
+    assert end.things["coke"] == ("delivered", "person")
 
 
 @pytest.mark.parametrize("name", ["household_tune", "household_dev", "household_dev2"])

@@ -253,7 +253,7 @@ def _carry_out(node: dict[str, Any], state: Situation, world: WorldConfig, insta
         container = str(params["into"])
         state.things[_held(state, kind)] = ("inside", container)
         state.robot_at = world.containers[container].place if container in world.containers else None
-    elif kind == "give":
+    elif kind in ("give", "hand_over"):  # judged as meant: in the person's hand
         state.things[_held(state, kind)] = ("delivered", str(params.get("to", PERSON)))
         state.robot_at = PERSON
     elif kind == "navigate":

@@ -678,7 +678,15 @@ class EmbeddedPlanner:
         if person is None:
             raise PlanRefused("There is nobody here to give it to.")
         state.steps.append({"navigate": {"person": person}})
-        state.steps.append({"give": {"to": person}})
+        # if they do not take it, it goes on the surface nearest them with room: never dropped, never kept
+        state.position = np.asarray(context.belief.person(person)[:2], dtype=float)
+        surface = self._nearest_surface(state, context)
+        place = context.world.surfaces[surface].place
+        approach = np.array(context.world.places[place].pose[:2])
+        spot = free_spot(context.belief.surface(surface), context.belief, approach, also_taken=state.spots)
+        state.spots.append(spot)
+        x, y = round(float(spot[0]), 3), round(float(spot[1]), 3)
+        state.steps.append({"hand_over": {"to": person, "surface": surface, "place": place, "x": x, "y": y}})
         state.lines.append("bring it to you")
         state.held = None
         state.last = [target]

@@ -343,9 +343,9 @@ def _kind_of(tracked: TrackedObject, context: PlanningContext) -> str | None:
 # --- one hand ---------------------------------------------------------------------------------------------------
 
 PICKS_UP = {"take", "fetch", "throw_away", "pick", "grasp"}  # steps that start by picking their object up
-LETS_GO = {"give", "place", "drop", "put", "release"}  # steps that leave the hand empty
+LETS_GO = {"give", "hand_over", "place", "drop", "put", "release"}  # steps that leave the hand empty
 CARRIES_OFF = {"fetch", "throw_away"}  # steps that pick up and let go again
-GIVES_AWAY = {"give", "drop", "throw_away"}  # after these the thing is with a person or in a bin
+GIVES_AWAY = {"give", "hand_over", "drop", "throw_away"}  # after these the thing is with a person or in a bin
 ONE_AT_A_TIME = {"sequence", "reactive_sequence"}  # composites whose children run one after another
 UNKNOWN = "?"  # what the hand holds when branches of a plan disagree: not checked further
 NODE_EXTRAS = ("name", "recovery")  # keys beside a node's kind (mission/schema.py's; a test keeps them equal:

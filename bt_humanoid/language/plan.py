@@ -47,7 +47,7 @@ class Plan:
         return self.kind == "question" or (self.kind == "refusal" and self.understood)
 
 
-OBJECT_STEPS = {"take", "fetch", "throw_away", "find", "give", "place", "drop", "pick", "turn"}
+OBJECT_STEPS = {"take", "fetch", "throw_away", "find", "give", "hand_over", "place", "drop", "pick", "turn"}
 
 
 def _kinds(node: Any) -> set[str]:
@@ -103,7 +103,7 @@ def mission_signature(tree: dict[str, Any]) -> list[str]:
         return [f"navigate {params['place']}" if params.get("place") else "navigate object"]
     if kind == "place":
         return [f"place {params['surface']}"]
-    if kind == "give":
+    if kind in ("give", "hand_over"):  # a hand-over is a give with somewhere to put it if not taken
         return [f"give {params.get('to', 'person') if params.get('to') in (None, 'person') else params['to']}"]
     if kind == "move_base" and params.get("relative"):
         if params.get("x") is not None:

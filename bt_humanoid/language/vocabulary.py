@@ -63,7 +63,7 @@ INTENTS: dict[str, Intent] = {
     "bring_me": Intent(
         ("bring", "fetch", "give", "hand", "get"),
         ("pass", "deliver", "send", "toss", "grab"),
-        ("take", "navigate", "give"),
+        ("take", "navigate", "hand_over"),
     ),
     # "carry X to the counter" (put) and "carry X to me" (bring): the same verbs when typed
     "carry_to_surface": Intent(
@@ -74,9 +74,9 @@ INTENTS: dict[str, Intent] = {
     "carry_to_person": Intent(
         ("bring", "take", "carry"),
         ("fetch", "get", "hand", "give", "pass", "move", "deliver", "run"),
-        ("take", "navigate", "give"),
+        ("take", "navigate", "hand_over"),
     ),
-    "bring_here": Intent((), ("bring", "fetch"), ("take", "navigate", "give")),  # "bring the mug here"
+    "bring_here": Intent((), ("bring", "fetch"), ("take", "navigate", "hand_over")),  # "bring the mug here"
     "put": Intent(
         ("put", "place", "set"),
         (
