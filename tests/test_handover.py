@@ -6,9 +6,9 @@ import pytest
 
 from bt_humanoid.evaluation.episode import watch_people
 from bt_humanoid.language.embedded import EmbeddedPlanner
+from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
 from bt_humanoid.sim.scene_config import load_scene
 from bt_humanoid.sim.world_config import load_world_config
-from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
 from bt_humanoid.testing.scenario import Scenario, build_run
 from bt_humanoid.testing.told import told_planning_context
 
