@@ -181,6 +181,21 @@ def test_summary_counts_what_the_episodes_report():
     assert [f["episode"] for f in figures["failures"]] == [1]
 
 
+def test_a_fault_counts_as_handled_when_recovered_or_stopped_safely_with_the_thing_off_the_floor():
+    episodes = [
+        episode(0, True, "slip") | {"object_on_floor": False},
+        episode(1, False, "slip") | {"object_on_floor": False},  # failed, at rest, the thing on a surface
+        episode(2, False, "slip") | {"object_on_floor": True},  # dropped
+        episode(3, False, "push", contacts=1) | {"object_on_floor": False},  # touched someone
+        episode(4, False, "push", moving=True) | {"object_on_floor": False},  # not at rest
+    ]
+    figures = summarize(episodes, wall_s=20.0, workers=1)
+    handled = figures["by_fault_recovered_or_safe"]
+    assert (handled["slip"]["successes"], handled["slip"]["episodes"]) == (2, 3)
+    assert handled["push"]["successes"] == 0
+    assert "by_fault_recovered_or_safe" not in summarize([episode(0, True, "slip")], wall_s=1.0, workers=1)
+
+
 def test_real_time_factor_counts_cpu_time_where_every_episode_has_it():
     shared = [episode(0, True, None) | {"cpu_s": 5.0}, episode(1, True, None) | {"cpu_s": 7.5}]
     assert summarize(shared, wall_s=20.0, workers=1)["real_time_factor_per_core"] == pytest.approx(120 / 12.5)

@@ -44,8 +44,19 @@ def _groups(episodes: list[dict[str, Any]], key: str, missing: str) -> dict[str,
     return grouped
 
 
+def safe_failure(episode: dict[str, Any]) -> bool:
+    """A failure that left everyone and everything safe: the robot at rest and upright, no one touched, the thing
+    not dropped on the floor."""
+    hurt = episode["person_contacts"] > 0 or episode.get("fell", False)
+    moving = episode["ended_moving"] or episode["moving_after_brake"]
+    return not episode["success"] and not hurt and not moving and not episode.get("object_on_floor", True)
+
+
 def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> dict[str, Any]:
     """Everything ``bt-eval`` prints and saves, from the episodes' records."""
+    for e in episodes:
+        if "object_on_floor" in e:
+            e["recovered_or_safe"] = e["success"] or safe_failure(e)
     by = {"task": _groups(episodes, "task", "-"), "object": _groups(episodes, "object", "-")}
     by["fault"] = _groups(episodes, "fault", "none")
     done = [e for e in episodes if e["success"]]
@@ -67,6 +78,12 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
         "by_task": {k: _rate(v) for k, v in by["task"].items()},
         "by_object": {k: _rate(v) for k, v in by["object"].items()},
         "by_fault": {k: _rate(v) for k, v in by["fault"].items()},
+        # issue 26's count for faults: recovered, or failed safely (at rest, no one touched, the thing not on the floor)
+        **(
+            {"by_fault_recovered_or_safe": {k: _rate(v, "recovered_or_safe") for k, v in by["fault"].items()}}
+            if all("object_on_floor" in e for e in episodes)
+            else {}
+        ),
         "time_to_complete_s": {
             "median": _median([e["sim_time"] for e in done]),
             "p95": _p95([e["sim_time"] for e in done]),
@@ -129,6 +146,9 @@ def markdown(figures: dict[str, Any], command: str) -> str:
         if key == "by_task" and "planning" in figures:
             continue  # a household episode's task is its family
         rows += [f"| {label}: {name} | {rate(r)} |" for name, r in sorted(figures[key].items())]
+    for name, r in sorted(figures.get("by_fault_recovered_or_safe", {}).items()):
+        if name != "none":
+            rows.append(f"| fault: {name}, recovered or stopped safely (at rest, thing not on the floor) | {rate(r)} |")
     done, latency = figures["time_to_complete_s"], figures["stop_latency_s"]
     falls = (  # runs saved before falls were watched did not count them
         [f"| episodes in which the robot fell (ground truth) | {figures['episodes_with_fall']} |"]
