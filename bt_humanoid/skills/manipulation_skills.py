@@ -224,6 +224,8 @@ class StandNearParams(StrictModel):
 
 
 STANCE_ARRIVAL = 0.15  # m: the first and last stretch at a stance may graze the map's margin round furniture
+STEP_BACK_TO_RAISE = 0.35  # m back from a surface before a folded arm swings out to the ready posture
+UNFOLDED = 0.2  # rad: an arm within this of the ready posture in every joint is ready already
 APPROACH_BACKOFF = 0.3  # m behind a stance, at most, where navigation may end before the straight last stretch
 
 
@@ -245,20 +247,41 @@ class StandNear(_ManipulationSkill):
     def phases(self):
         return [
             ("tuck the other arm", self._tuck),
+            ("step back to raise the arm", self._step_back),
             ("raise the arm", self._raise_arm),
             ("hand up", self._hand_up),
             ("approach", self._approach),
             ("stance", self._drive),
         ]
 
-    def _raise_arm(self) -> MotionHandle | None:
-        """An empty working arm goes to the ready posture (a good start for reaches); a full one stays as carried."""
+    def _ready_posture(self) -> dict[str, float]:
+        """Where the empty working arm (and the torso lift) go before the stance: none for a full arm, which stays
+        as carried."""
         if self.context.world_model.held(self.params.side) is not None:
-            return None
+            return {}
         config = self.context.robot_config
         joints = [*config.groups.get("lift", []), *config.groups.get(f"{self.params.side}_arm", [])]
         ready = config.postures.get(READY_POSTURE, {})
-        return self.context.robot.joints.move({j: ready[j] for j in joints if j in ready})
+        return {j: ready[j] for j in joints if j in ready}
+
+    def _step_back(self) -> MotionHandle | None:
+        """Away from a surface the robot stands at before a folded arm swings out to the ready posture: beside a
+        counter the hand swings into its side, and the arm then lies on its top, straining at the shoulder."""
+        from bt_humanoid.skills.navigation_skills import at_a_surface, back_up  # they build on this module
+
+        ready = self._ready_posture()
+        if not ready or not at_a_surface(self.context):
+            return None
+        joints = self.context.robot.joints
+        now = joints.position[joints.indices(list(ready))]
+        if np.max(np.abs(now - np.array(list(ready.values())))) < UNFOLDED:
+            return None  # ready already: nothing swings out
+        return back_up(self.context, STEP_BACK_TO_RAISE)
+
+    def _raise_arm(self) -> MotionHandle | None:
+        """An empty working arm goes to the ready posture (a good start for reaches); a full one stays as carried."""
+        ready = self._ready_posture()
+        return self.context.robot.joints.move(ready) if ready else None
 
     def _hand_up(self) -> MotionHandle | None:
         """Raise the empty hand, held out at the ready posture, over the things it will pass as the base drives
