@@ -97,3 +97,12 @@ def test_things_told_apart_by_look_are_never_folded():
     belief.objects["can-1"].seen_from = belief.objects["can-2"].seen_from = 3.0
     integrate(belief, [coke], _frame(0.0, 2.0))
     assert len(belief.objects) == 2
+
+
+def test_two_things_once_seen_side_by_side_stay_two_when_one_hides_the_other():
+    belief = WorldModel()
+    integrate(belief, [_bottle(4.0, 0.0), _bottle(4.0, 0.075)], _frame(0.0, 0.0))  # both, from 4 m
+    integrate(belief, [_bottle(4.0, 0.07)], _frame(0.0, 1.0))  # now one is behind the other: one shows
+    assert len(belief.objects) == 2
+    integrate(belief, [], _frame(0.0, 2.0))  # out of view: nothing new to fold on
+    assert len(belief.objects) == 2

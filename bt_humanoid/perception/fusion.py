@@ -63,6 +63,8 @@ def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame)
             tracked.confidence *= LOSS
             if tracked.confidence < GONE:
                 tracked.confidence = 0.0
+    for key in seen:
+        belief.objects[key].seen_with |= seen - {key}
     _fold_duplicates(belief, seen)
     _reidentify(belief)
 
@@ -93,8 +95,9 @@ def _associate(belief: WorldModel, detections: list[Detection], ranges: list[flo
 
 
 def _fold_duplicates(belief: WorldModel, seen: set[str]) -> None:
-    """Two believed objects of one colour closer than the gate, not both seen in this frame, are one object seen
-    twice (a far look's guess and a near look's): the younger is folded into the older, whose id plans hold."""
+    """Two believed objects of one colour closer than the gate, one of them seen in this frame and never both in
+    one frame, are one object seen twice (a far look's guess and a near look's): the younger is folded into the
+    older, whose id plans hold."""
     present = sorted(
         (o for o in belief.objects.values() if o.held_by is None and o.confidence > 0.0), key=lambda o: o.first_seen
     )
@@ -104,8 +107,8 @@ def _fold_duplicates(belief: WorldModel, seen: set[str]) -> None:
                 continue
             if None not in (older.identity, younger.identity) and older.identity != younger.identity:
                 continue  # told apart by look (a coke and a cherry coke)
-            if older.id in seen and younger.id in seen:
-                continue  # one frame saw both: two things
+            if (older.id in seen) == (younger.id in seen) or younger.id in older.seen_with:
+                continue  # a frame saw both (two things), or this one neither (nothing new to say)
             if np.linalg.norm(older.position - younger.position) < gate(older, younger.seen_from):
                 _fold(belief, younger, older)
 
@@ -116,6 +119,7 @@ def _fold(belief: WorldModel, younger: TrackedObject, older: TrackedObject) -> N
     if younger.yaw_known or not older.yaw_known:
         older.yaw, older.yaw_known = younger.yaw, younger.yaw_known
     older.votes += younger.votes
+    older.seen_with |= younger.seen_with
     older.confidence = max(older.confidence, younger.confidence)
     older.last_seen = max(older.last_seen, younger.last_seen)
     _vote(older)

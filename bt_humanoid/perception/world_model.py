@@ -41,6 +41,7 @@ class TrackedObject:
     votes: Counter = field(default_factory=Counter)  # (kind, colour, identity) → sightings, when perception tracks it
     identity: str | None = None  # which of the world's objects it is ("coke"), where its look tells them apart
     seen_from: float = 0.0  # m from the camera of the nearest view its position comes from (0: not from a camera)
+    seen_with: set[str] = field(default_factory=set)  # ids of objects one frame saw beside it: never the same thing
 
     @property
     def bottom(self) -> float:
