@@ -1,10 +1,11 @@
 """Handing things to a person who takes them: their arm reaches, their fingers close, the robot feels the pull."""
 
 import math
+from pathlib import Path
 
 import pytest
 
-from bt_humanoid.evaluation.episode import watch_people
+from bt_humanoid.evaluation.episode import run_episode, watch_people
 from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
 from bt_humanoid.sim.scene_config import load_scene
@@ -87,3 +88,15 @@ def test_what_a_busy_person_does_not_take_is_put_down_on_the_surface_nearest_the
     assert scenario.truth.upright("coke")
     assert scenario.result.summary()["outcome"] == "failure", scenario.result.summary()  # the person has not got it
     assert not scenario.touched  # type: ignore[attr-defined]
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+def test_the_loosened_fingers_do_not_drag_a_pulled_cube_out_of_the_person_s_hand():
+    # the fetch suite's episode 9: the person's pull pressed the cube against one pad; loosened by 3 cm, that pad
+    # kept touching it, and the hand rising clear dragged it up out of their fingers onto the floor
+    fetch = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "fetch.yaml")
+    record = run_episode(fetch, 9)
+    assert record["command"] == "bring me the red cube"
+    assert record["success"], record["failure"]
+    assert record["person_contacts"] == 0 and not record["object_on_floor"]
