@@ -41,10 +41,10 @@ def test_the_gate_grows_with_the_range_of_the_look_and_of_the_track():
     belief = WorldModel()
     integrate(belief, [_bottle(4.0, 0.0)], _frame(0.0, 0.0))
     tracked = belief.objects["bottle-1"]
-    assert gate(tracked, 1.0) > gate(tracked, 0.5) - 1e-9
-    assert gate(tracked, 4.0) > gate(tracked, 1.0) + 0.05
+    assert gate(tracked, 0.6) > 0.1  # the track's own view was far
     tracked.seen_from = 0.6
-    assert gate(tracked, 0.6) < gate(tracked, 4.0)
+    assert gate(tracked, 1.0) == gate(tracked, 0.5) == 0.06  # near looks at a near-seen track: 6 cm
+    assert gate(tracked, 4.0) > gate(tracked, 1.0) + 0.05
 
 
 def test_a_near_look_moves_a_far_estimate_more_than_a_far_look_moves_a_near_one():
@@ -106,3 +106,17 @@ def test_two_things_once_seen_side_by_side_stay_two_when_one_hides_the_other():
     assert len(belief.objects) == 2
     integrate(belief, [], _frame(0.0, 2.0))  # out of view: nothing new to fold on
     assert len(belief.objects) == 2
+
+
+def test_a_thing_of_another_colour_beside_it_is_not_the_far_object():
+    belief = WorldModel()
+    integrate(belief, [_bottle(5.0, 0.0)], _frame(0.0, 0.0))  # a blue bottle from 5 m
+    integrate(belief, [_bottle(5.0, 0.12, colour="white", kind="mug")], _frame(0.0, 1.0))  # a white mug 12 cm off
+    assert belief.objects["bottle-1"].name == "blue bottle"
+    assert sorted(belief.objects) == ["bottle-1", "mug-1"]
+
+
+def test_the_gate_has_a_ceiling():
+    belief = WorldModel()
+    integrate(belief, [_bottle(9.0, 0.0)], _frame(0.0, 0.0))  # from 9 m
+    assert gate(belief.objects["bottle-1"], 9.0) <= 0.15

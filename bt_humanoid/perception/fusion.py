@@ -31,6 +31,7 @@ NEAR = 1.0  # m: up to this range a detection's centre is good to a centimetre (
 # m more per metre beyond NEAR, for the detection's range and for the track's nearest view: measured errors in
 # the apartment's fetch suite with sensor noise are 1.2 cm median, 2.1 cm p90 at 1.5-2 m, and up to 4.5 cm at 3.5-4 m
 RANGE_GATE = 0.025
+MAX_GATE = 0.15  # m: however far the looks, no nearer than this is the same thing (a mug 20 cm from a bottle is not)
 GAIN = 0.35  # confidence gained per sighting
 LOSS = 0.5  # factor on confidence per frame an object should have been seen and was not
 GONE = 0.15  # below this confidence an object is no longer believed to be there
@@ -69,9 +70,14 @@ def integrate(belief: WorldModel, detections: list[Detection], frame: RgbdFrame)
     _reidentify(belief)
 
 
-def gate(tracked: TrackedObject, distance: float) -> float:
-    """How near (m) a detection made from ``distance`` m must lie to ``tracked``'s centre to be it."""
-    return ASSOCIATE + RANGE_GATE * (max(0.0, distance - NEAR) + max(0.0, tracked.seen_from - NEAR))
+def gate(tracked: TrackedObject, distance: float, colour: str | None = None) -> float:
+    """How near (m) a detection made from ``distance`` m must lie to ``tracked``'s centre to be it. Only one of
+    the same ``colour`` gets the allowance for range: a white mug seen beside a blue bottle from across the room
+    is not the bottle."""
+    if colour is not None and colour != tracked.colour:
+        return ASSOCIATE
+    grown = RANGE_GATE * (max(0.0, distance - NEAR) + max(0.0, tracked.seen_from - NEAR))
+    return min(ASSOCIATE + grown, MAX_GATE)
 
 
 def _associate(belief: WorldModel, detections: list[Detection], ranges: list[float]) -> dict[int, TrackedObject]:
@@ -83,7 +89,7 @@ def _associate(belief: WorldModel, detections: list[Detection], ranges: list[flo
             if tracked.held_by is not None:
                 continue
             distance = float(np.linalg.norm(tracked.position - detection.position))
-            if distance < gate(tracked, ranges[index]):
+            if distance < gate(tracked, ranges[index], detection.colour):
                 pairs.append((distance, index, tracked.id))
     matched: dict[int, TrackedObject] = {}
     taken: set[str] = set()
