@@ -4,6 +4,7 @@ The physics runs are bt-eval's (docs/results.md); here the planning side is chec
 where the scene puts them), which needs no camera and no stepping.
 """
 
+import dataclasses
 from functools import cache
 
 import numpy as np
@@ -230,3 +231,10 @@ def test_the_planner_plans_the_tuning_sets_from_told_scenes(name):
         if problem:
             wrong[instruction.say] = problem
     assert 1 - len(wrong) / len(suite.instructions) >= 0.9, wrong
+
+
+def test_with_nowhere_to_put_it_down_bring_me_plans_a_plain_give():
+    context = _context("holding_coke")
+    bare = dataclasses.replace(context, world=context.world.model_copy(update={"surfaces": {}}))
+    plan = EmbeddedPlanner().plan("bring me the coke", bare)
+    assert [next(iter(step)) for step in plan.mission["tree"]["sequence"]] == ["navigate", "give"]

@@ -75,3 +75,18 @@ def test_robot_starts_at_the_start_pose(sim):
     x, y, yaw = GroundTruth(sim).robot_pose()
     sx, sy, syaw = sim.world.robot_start
     assert (x, y) == pytest.approx((sx, sy)) and yaw == pytest.approx(math.radians(syaw))
+
+
+@pytest.mark.sim
+def test_a_thing_knocked_to_the_floor_is_on_the_floor_and_one_on_the_table_is_not(sim):
+    sim.reset()
+    truth = GroundTruth(sim)
+    sim.step(100)
+    assert not truth.on_floor("red cube")
+    cube = sim.model.body(sim.object_bodies["red cube"]).id
+    joint = sim.model.body_jntadr[cube]
+    address = sim.model.jnt_qposadr[joint]
+    sim.data.qpos[address : address + 3] = [3.0, -1.2, 0.2]  # beside the table, just above the floor: it falls
+    sim.step(500)
+    assert truth.on_floor("red cube")
+    assert truth.object_position("red cube")[2] < 0.1

@@ -110,7 +110,7 @@ def run_episode(
     stack = _set_up(suite, draw, record)
     try:
         record |= _play(suite, suite_file, task, draw, fault, stack)
-        record["object_on_floor"] = on_the_floor(stack, draw.obj) if draw.obj else None
+        record["object_on_floor"] = stack.truth.on_floor(draw.obj) if draw.obj else None
         if events is not None:
             events.extend(stack.events.events)
     finally:
@@ -244,16 +244,6 @@ def _play(suite: Suite, suite_file: str, task: Task, draw: Draw, fault, stack: R
     return episode_verdict(
         stack, result, figures, expect, injector=injector, touched=touched, fell=fell, believed=believed
     )
-
-
-FLOOR_HEIGHT = 0.3  # m: a thing's centre lower than this is on the floor (every surface it is put on is higher)
-
-
-def on_the_floor(stack: RobotStack, obj: str) -> bool:
-    """Whether ``obj`` ended on the floor, in ground truth: dropped, not put down, held or handed over."""
-    truth = stack.truth
-    held = truth.in_hand(obj) is not None or truth.held_by_person(obj) is not None
-    return not held and float(truth.object_position(obj)[2]) < FLOOR_HEIGHT
 
 
 def watch_people(run: MissionRun, stack: RobotStack) -> list[float]:

@@ -52,11 +52,13 @@ def safe_failure(episode: dict[str, Any]) -> bool:
     return not episode["success"] and not hurt and not moving and not episode.get("object_on_floor", True)
 
 
+def _handled(episodes: list[dict[str, Any]]) -> dict[str, Any]:
+    """The rate of episodes that succeeded or failed safely."""
+    return _rate([{"success": e["success"] or safe_failure(e)} for e in episodes])
+
+
 def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> dict[str, Any]:
     """Everything ``bt-eval`` prints and saves, from the episodes' records."""
-    for e in episodes:
-        if "object_on_floor" in e:
-            e["recovered_or_safe"] = e["success"] or safe_failure(e)
     by = {"task": _groups(episodes, "task", "-"), "object": _groups(episodes, "object", "-")}
     by["fault"] = _groups(episodes, "fault", "none")
     done = [e for e in episodes if e["success"]]
@@ -80,7 +82,7 @@ def summarize(episodes: list[dict[str, Any]], wall_s: float, workers: int) -> di
         "by_fault": {k: _rate(v) for k, v in by["fault"].items()},
         # issue 26's count for faults: recovered, or failed safely (at rest, no one touched, the thing not on the floor)
         **(
-            {"by_fault_recovered_or_safe": {k: _rate(v, "recovered_or_safe") for k, v in by["fault"].items()}}
+            {"by_fault_recovered_or_safe": {k: _handled(v) for k, v in by["fault"].items()}}
             if all("object_on_floor" in e for e in episodes)
             else {}
         ),

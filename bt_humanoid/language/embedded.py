@@ -678,15 +678,14 @@ class EmbeddedPlanner:
         if person is None:
             raise PlanRefused("There is nobody here to give it to.")
         state.steps.append({"navigate": {"person": person}})
-        # if they do not take it, it goes on the surface nearest them with room: never dropped, never kept
         state.position = np.asarray(context.belief.person(person)[:2], dtype=float)
-        surface = self._nearest_surface(state, context)
-        place = context.world.surfaces[surface].place
-        approach = np.array(context.world.places[place].pose[:2])
-        spot = free_spot(context.belief.surface(surface), context.belief, approach, also_taken=state.spots)
-        state.spots.append(spot)
-        x, y = round(float(spot[0]), 3), round(float(spot[1]), 3)
-        state.steps.append({"hand_over": {"to": person, "surface": surface, "place": place, "x": x, "y": y}})
+        try:  # if they do not take it, it goes on the surface nearest them with room: never dropped, never kept
+            surface = self._nearest_surface(state, context)
+        except PlanRefused:  # nowhere to put it: a plain give, which keeps it if they do not take it
+            state.steps.append({"give": {"to": person}})
+        else:
+            place, x, y = self._promise_spot(surface, state, context)
+            state.steps.append({"hand_over": {"to": person, "surface": surface, "place": place, "x": x, "y": y}})
         state.lines.append("bring it to you")
         state.held = None
         state.last = [target]
@@ -737,14 +736,8 @@ class EmbeddedPlanner:
             state.lines.append(f"leave the {target} on the {_spoken(surface_name)}, where it is")  # "make sure …"
             state.last = [target]
             return
-        surface = context.belief.surface(surface_name)
-        place = context.world.surfaces[surface_name].place
+        place, x, y = self._promise_spot(surface_name, state, context)
         approach = np.array(context.world.places[place].pose[:2])
-        spot = free_spot(surface, context.belief, approach, also_taken=state.spots)
-        if spot is None:
-            raise PlanRefused(f"There is no free spot left on the {_spoken(surface_name)}.")
-        state.spots.append(spot)
-        x, y = round(float(spot[0]), 3), round(float(spot[1]), 3)
         if state.held == target:
             state.steps.append({"navigate": {"place": place}})
             state.steps.append({"place": {"surface": surface_name, "x": x, "y": y}})
@@ -760,6 +753,16 @@ class EmbeddedPlanner:
         state.done[target] = ("on", surface_name)
         state.surface = surface_name
         state.position = approach
+
+    def _promise_spot(self, surface_name: str, state: _State, context: PlanningContext) -> tuple[str, float, float]:
+        """A free spot on the surface, nearest where it is worked from, kept for this plan: (place, x, y)."""
+        place = context.world.surfaces[surface_name].place
+        approach = np.array(context.world.places[place].pose[:2])
+        spot = free_spot(context.belief.surface(surface_name), context.belief, approach, also_taken=state.spots)
+        if spot is None:
+            raise PlanRefused(f"There is no free spot left on the {_spoken(surface_name)}.")
+        state.spots.append(spot)
+        return place, round(float(spot[0]), 3), round(float(spot[1]), 3)
 
     def _nearest_surface(self, state: _State, context: PlanningContext, besides: str | None = None) -> str:
         """The surface nearest where the robot will be that has room (for putting something down)."""

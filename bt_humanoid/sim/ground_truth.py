@@ -88,6 +88,14 @@ class GroundTruth:
         top = self.data.geom_xpos[geom][2] + self.model.geom_size[geom][2]
         return bool(self.object_position(obj)[2] > top and self.object_speed(obj) < RESTING_SPEED)
 
+    def on_floor(self, obj: str) -> bool:
+        """The object touches the floor (the world's geom named "floor") and no hand holds it: dropped, not put
+        down, handed over or binned."""
+        if self.in_hand(obj) is not None or self.held_by_person(obj) is not None:
+            return False
+        floor = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+        return floor >= 0 and floor in self.geoms_in_contact(self._object_body(obj))
+
     def inside(self, obj: str, container: str) -> bool:
         """The object's centre lies within the container's opening (in plan) and below the top of its walls."""
         bin_ = self.sim.world.containers[container]

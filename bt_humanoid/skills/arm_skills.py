@@ -24,7 +24,9 @@ GIVE_HEIGHT = 1.0  # m
 SETTLE = 0.5  # s the held-out hand is read still before the pull is looked for
 PULL = 4.0  # N of change in the wrist's force that is the person taking it ...
 PULL_FOR = 0.15  # s ... felt this long
-LOOSEN = 0.06  # m the fingers open by: off the thing, short of the person's hand round it
+# m the fingers open by: off the thing (by 3 cm, a pad the person's pull pressed a cube against stayed on it, and the
+# hand rising clear dragged the cube out of their fingers)
+LOOSEN = 0.06
 LIFT_CLEAR = 0.12  # m the empty hand rises, up out of the person's grip
 
 
