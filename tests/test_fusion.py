@@ -120,3 +120,15 @@ def test_the_gate_has_a_ceiling():
     belief = WorldModel()
     integrate(belief, [_bottle(9.0, 0.0)], _frame(0.0, 0.0))  # from 9 m
     assert gate(belief.objects["bottle-1"], 9.0) <= 0.15
+
+
+def test_a_few_near_looks_outvote_many_far_ones():
+    """From 3 m a mug with its handle turned away reads as a white ball; from 1 m its handle shows."""
+    belief = WorldModel()
+    for time in range(6):
+        integrate(belief, [_bottle(4.0, 0.0, colour="white", kind="ball")], _frame(0.6, float(time)))
+    assert belief.objects["ball-1"].kind == "ball"
+    for time in range(6, 9):
+        integrate(belief, [_bottle(4.0, 0.0, colour="white", kind="mug")], _frame(3.0, float(time)))
+    assert belief.objects["ball-1"].kind == "mug"
+    assert belief.object("white mug").id == "ball-1"  # plans that named the ball still find it

@@ -100,3 +100,24 @@ def test_the_loosened_fingers_do_not_drag_a_pulled_cube_out_of_the_person_s_hand
     assert record["command"] == "bring me the red cube"
     assert record["success"], record["failure"]
     assert record["person_contacts"] == 0 and not record["object_on_floor"]
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+@pytest.mark.parametrize(
+    "seed, episode",
+    [
+        # the handle stood 45° off the person's fingers: one finger landed on its flank, not on the mug, and the
+        # fingers closing pushed the mug 4 N back at the robot, which let go then (a push, not a take)
+        (0, 43),
+        # the person drew the mug 6 cm towards themselves against the loosened near pad; the hand rising clear
+        # dragged along it and flicked the mug out of their fingers
+        (1, 44),
+    ],
+)
+def test_the_person_takes_a_mug_held_out_with_its_handle_to_their_side(seed: int, episode: int):
+    fetch = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "fetch.yaml")
+    record = run_episode(fetch, episode, seed=seed)
+    assert record["command"] == "bring me the coffee mug"
+    assert record["success"], record["failure"]
+    assert record["person_contacts"] == 0 and not record["object_on_floor"]

@@ -115,7 +115,7 @@ def test_objects_are_unknown_until_seen_then_fused_over_frames():
     cube = belief.object("red cube")
     assert cube.kind == "cube" and cube.colour == "red" and cube.confidence == pytest.approx(1.0)
     assert np.linalg.norm(cube.position - run.truth.object_centre("red cube")) < 0.01
-    assert sum(cube.votes.values()) == 3
+    assert list(cube.votes) == [("cube", "red", None)]  # three sightings (confidence 1.0), all of one mind
     assert belief.object("water bottle").kind == "bottle"  # the world's name for a blue bottle
 
 

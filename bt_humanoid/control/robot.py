@@ -82,10 +82,19 @@ class RobotController:
         self.separation: Separation | None = None  # set with monitor_separation()
         self.control_period = 0.01  # s between step() calls; the executor sets it
 
-    def wrist_force(self, side: str) -> np.ndarray | None:
-        """What the wrist's force sensor reads (N, in the hand's frame), on a hand that has one (robot.yaml)."""
+    def wrist_force(self, side: str, in_world: bool = False) -> np.ndarray | None:
+        """What the wrist's force sensor reads (N): the force the wrist exerts on the hand and what it holds, in
+        the sensor's frame, or turned into the world's by the arm's pose from the encoders (``in_world``); None
+        for a hand without one (robot.yaml)."""
         sensor = self.config.grippers[side].wrist_force
-        return None if sensor is None else self.body_io.sensor(sensor).copy()
+        if sensor is None:
+            return None
+        reading = self.body_io.sensor(sensor).copy()
+        if not in_world:
+            return reading
+        model = self.body_io.sim.model
+        frame = model.site(int(model.sensor(sensor).objid[0])).name
+        return self.whole_body.frame_pose(frame).rotation @ reading
 
     def set_control_period(self, period: float) -> None:
         """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""

@@ -38,7 +38,7 @@ class TrackedObject:
     # base (x, y) the next stance to work on it stands at: where the hand fell short of it from, moved by the miss
     step_to: np.ndarray | None = None
     yaw_known: bool = True  # false while a mug's handle has not been seen (its yaw is a guess)
-    votes: Counter = field(default_factory=Counter)  # (kind, colour, identity) → sightings, when perception tracks it
+    votes: Counter = field(default_factory=Counter)  # (kind, colour, identity) → sightings, near ones weighing more
     identity: str | None = None  # which of the world's objects it is ("coke"), where its look tells them apart
     seen_from: float = 0.0  # m from the camera of the nearest view its position comes from (0: not from a camera)
     seen_with: set[str] = field(default_factory=set)  # ids of objects one frame saw beside it: never the same thing

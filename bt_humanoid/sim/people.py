@@ -35,7 +35,9 @@ SHOULDER_OUT = 0.18  # m from the body's axis, towards where the arm points
 UPPER_ARM, FOREARM = 0.3, 0.27  # m
 PALM_DEPTH = 0.03  # m from the wrist to the palm's front
 FINGER_LENGTH = 0.11  # m ahead of the palm
-FINGER_OPEN = 0.06  # m each fingertip's inner face stands from the hand's middle when open
+# m each fingertip's inner face stands from the hand's middle when open: wide enough to pass round a mug's handle
+# (7.5 cm from its middle), as an open hand does
+FINGER_OPEN = 0.09
 # the fingertips, 3 cm long, stand proud of the fingers by 1.2 cm, this far ahead of the palm: they meet the thing
 # at its middle, and the rest of the finger passes the robot's fingers on its near and far faces
 TIP_AT, TIP_LENGTH, TIP_DEPTH = 0.08, 0.03, 0.012
@@ -50,7 +52,7 @@ TURN_RATE = 1.5  # rad/s ... and turns at
 TURNED = 0.05  # rad: the arm turns to the thing first, low, to within this ...
 APPROACH = 0.12  # m ... then the hand comes level with the thing this far back, then slides round it
 CLOSE_TIME = 0.5  # s the fingers take to close before the pull
-PULL = np.array([-0.06, 0.03])  # m: (towards themselves, up) the hand draws a taken thing, slowly ...
+PULL = np.array([-0.02, 0.04])  # m: (towards themselves, up) the hand draws a taken thing, slowly ...
 PULL_SPEED = 0.05  # m/s
 HOLD = np.array([0.2, 1.0])  # m: (wrist from the body's axis, height) where they hold what they took ...
 WAIT_CLEAR = 1.5  # s ... once the robot's hand has had this long to withdraw (its finger is on their side)
@@ -282,10 +284,17 @@ class PersonDriver:
         return HandPose(yaw, float(np.hypot(*from_axis)), float(centre[2]), turn)
 
     def _face(self, body: int, towards: np.ndarray) -> np.ndarray:
-        """The unit direction into the thing the hand squares up to: of a box, its side most nearly facing them;
-        of anything round, the way they look at it."""
+        """The unit direction into the thing the hand squares up to: of a thing with a part standing out from it
+        (a mug's handle), across that part, so that the fingers close along it, one on its end and one on the far
+        side, and neither lands on its flank; of a box, its side most nearly facing them; of anything else round,
+        the way they look at it."""
         geoms = np.flatnonzero(self.model.geom_bodyid == body)
-        if len(geoms) != 1 or self.model.geom_type[geoms[0]] != mujoco.mjtGeom.mjGEOM_BOX:
+        if len(geoms) > 1:
+            outwards = self.data.geom_xpos[geoms, :2] - self.data.xpos[body][:2]
+            part = outwards[int(np.argmax(np.hypot(outwards[:, 0], outwards[:, 1])))]
+            across = np.array([-part[1], part[0]]) / max(float(np.hypot(*part)), 1e-9)
+            return across if float(across @ towards) >= 0.0 else -across
+        if self.model.geom_type[geoms[0]] != mujoco.mjtGeom.mjGEOM_BOX:
             return towards
         axes = self.data.geom_xmat[geoms[0]].reshape(3, 3)[:2, :2].T  # the box's x and y axes, on the floor
         dots = axes @ towards

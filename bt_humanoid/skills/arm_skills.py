@@ -20,9 +20,11 @@ from bt_humanoid.strict_model import StrictModel, exactly_one
 GIVE_REACH = 0.5  # m ahead of the base, towards the person, where the hand holds the object out
 GIVE_HEIGHT = 1.0  # m
 # A giver lets go as the taker takes the load (Chan et al. 2012, "Grip forces and load forces in handovers"): the
-# wrist's force sensor reads the person's pull, or their lifting, against what it read holding the thing out still.
+# wrist's force sensor reads the person's pull towards themselves, or their lifting, against what it read holding
+# the thing out still. Only those two count: a person's fingers closing round a mug push it back towards the robot
+# by 4 N before they hold it, and a hand let go then dropped it (fetch episode 43).
 SETTLE = 0.5  # s the held-out hand is read still before the pull is looked for
-PULL = 4.0  # N of change in the wrist's force that is the person taking it ...
+PULL = 4.0  # N of pull and lift together that is the person taking it ...
 PULL_FOR = 0.15  # s ... felt this long
 # m the fingers open by: off the thing (by 3 cm, a pad the person's pull pressed a cube against stayed on it, and the
 # hand rising clear dragged the cube out of their fingers)
@@ -154,20 +156,20 @@ class Give(_ManipulationSkill):
         p: GiveParams = self.params
         now = self.context.clock()
         waited = now - self.wait_started
-        force = self.context.robot.wrist_force(p.side)
+        force = self.context.robot.wrist_force(p.side, in_world=True)
         if self.context.blackboard.values.get(p.release_key):
             self.motion.succeed("asked to let go")
             return
         if force is not None and waited < SETTLE:
             self.still.append(force)
         elif force is not None and self.still:
-            change = float(np.linalg.norm(force - np.mean(self.still, axis=0)))
-            if change <= PULL:
+            taking = self._taking(force - np.mean(self.still, axis=0))
+            if taking <= PULL:
                 self.pulled_since = None
             elif self.pulled_since is None:
                 self.pulled_since = now
             if self.pulled_since is not None and now - self.pulled_since >= PULL_FOR:
-                self.motion.succeed(f"{p.to} took it: the wrist felt {change:.1f} N")
+                self.motion.succeed(f"{p.to} took it: the wrist felt {taking:.1f} N of pull and lift")
                 return
         if waited > p.timeout:
             self.motion.fail(f"{p.to} did not take the {self.held.name} in {p.timeout:.0f} s; still holding it")
@@ -176,6 +178,17 @@ class Give(_ManipulationSkill):
             self.context.speak(f"Please take the {self.held.name}.")
         else:
             self.motion.feedback = f"holding it out for {waited:.0f} s"
+
+    def _taking(self, change: np.ndarray) -> float:
+        """N of a change in the wrist's force (world frame) that is the person taking the thing: the wrist
+        holding it back against their pull towards themselves, and the weight they take off it. A push away
+        from them, or sideways, is not taking."""
+        hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
+        towards = self.context.world_model.person(self.params.to)[:2] - hand.translation[:2]
+        towards /= max(float(np.linalg.norm(towards)), 1e-9)
+        held_back = max(-float(change[:2] @ towards), 0.0)  # the wrist pulls away from them: they pull
+        lifted = max(-float(change[2]), 0.0)  # the wrist holds up less: they hold up the rest
+        return math.hypot(held_back, lifted)
 
     def _let_go(self) -> MotionHandle:
         self.held.held_by = None
