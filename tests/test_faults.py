@@ -9,13 +9,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+from pydantic import ValidationError
 
 from bt_humanoid.evaluation.episode import Draw, run_episode
+from bt_humanoid.evaluation.faults import FaultConfig, pick
 from bt_humanoid.evaluation.suite import load_suite
 
 SUITE = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "faults.yaml")
-KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command"]
+KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command", "arm_bump"]
 
 
 def _episode(kind: str) -> tuple[dict, list[dict]]:
@@ -91,6 +94,25 @@ def test_a_new_command_mid_mission_stops_the_robot_and_is_done_instead():
     assert _fault_time(events) < max(e["t"] for e in events if e["event"] == "start")
 
 
+@pytest.mark.slow
+@pytest.mark.sim
+def test_a_knock_on_the_carrying_arm_keeps_the_thing_in_hand():
+    record, _ = _episode("arm_bump")
+    assert "8 N·s" in record["fault_fired"] and "carrying the red cube" in record["fault_fired"]
+    assert record["success"], record["failure"]
+    assert not record["object_on_floor"] and not record["collision"]
+
+
+def test_a_fault_s_strength_may_be_a_span_drawn_per_episode():
+    config = FaultConfig.model_validate({"push": {"impulse": [40, 80]}})
+    draws = [pick(config.settings.impulse, np.random.default_rng(seed)) for seed in range(50)]
+    assert all(40 <= d <= 80 for d in draws) and max(draws) - min(draws) > 20
+    assert pick(FaultConfig.model_validate({"blind": {"seconds": 7}}).settings.seconds, np.random.default_rng()) == 7
+    for bad in ({"push": {"impulse": [80, 40]}}, {"push": {"impulse": 0}}, {"blind": {"seconds": [5, 90]}}):
+        with pytest.raises(ValidationError, match="low before high"):
+            FaultConfig.model_validate(bad)
+
+
 @pytest.mark.parametrize("kind", KINDS)
 def test_the_suite_takes_fault_kinds_in_turn(kind):
     suite, _ = load_suite(Path(SUITE))
@@ -108,5 +130,20 @@ def test_a_bottle_that_slips_but_stays_caught_in_the_pads_is_set_down_and_graspe
     assert record["fault"] == "slip" and record["fault_fired"]
     askew = [m for m in _failures(events) if "slipped in the right hand" in m]
     assert askew and "set it down to grasp it afresh" in askew[0], _failures(events)
+    assert record["success"], record["failure"]
+    assert record["person_contacts"] == 0 and not record["collision"]
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+def test_a_box_dropped_beside_the_base_out_of_the_camera_s_view_is_backed_away_from_and_driven_round():
+    # the fetch suite's episode 39 at seed 1: the box landed where the head camera, looking along the route, never
+    # saw it; the route passed it, a protective stop held the base 0.2 m from it for 10 s, and the search failed.
+    # Now what the base scanner senses goes on the map after a second's hold, and the robot backs out and replans
+    fetch = str(Path(SUITE).with_name("fetch.yaml"))
+    events: list[dict] = []
+    record = run_episode(fetch, 39, seed=1, events=events)
+    assert record["fault"] == "obstacle_dropped" and record["fault_fired"]
+    assert not any("protective stop" in m for m in _failures(events)), _failures(events)
     assert record["success"], record["failure"]
     assert record["person_contacts"] == 0 and not record["collision"]

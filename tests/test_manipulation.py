@@ -208,3 +208,23 @@ def test_give_lets_go_as_soon_as_asked():
     ended = next(e["t"] for e in scenario.events if e.get("node") == "sequence[3].parallel" and e["new"] == "SUCCESS")
     assert ended - started < 30.0  # long before the 60 s timeout
     assert scenario.truth.in_hand("red cube") is None
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+def test_a_grip_too_weak_for_the_bottle_s_weight_does_not_lift_it():
+    """The grasp holds by friction alone: at 1 N a finger (μ = 1 on each pad: 2 N at most against its 4.9 N
+    weight), the water bottle stays on the table and the pick fails; at the robot's 40 N it is lifted (the
+    pick-and-place test above)."""
+    mission = {"mission": "weak grip", "tree": {"sequence": [*TO_THE_TABLE, {"pick": {"object": "water bottle"}}]}}
+    run = build_run(mission)
+    model = run.sim.model
+    for name in ("r_finger_a", "r_finger_b", "l_finger_a", "l_finger_b"):
+        model.actuator_forcerange[model.actuator(name).id] = (-1.0, 1.0)
+    rest_height = run.truth.object_position("water bottle")[2]
+    scenario = Scenario(run, run.execute())
+    summary = scenario.result.summary()
+    assert summary["tree_status"] == "FAILURE", summary
+    assert any("fell out of the right hand" in why for why in summary["halted_by"]), summary
+    assert scenario.truth.in_hand("water bottle") is None
+    assert scenario.truth.object_position("water bottle")[2] < rest_height + 0.01, "not carried off"

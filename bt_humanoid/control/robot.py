@@ -41,6 +41,11 @@ class Separation(SpeedLimiter, Protocol):
 
     def update(self, base_pose: np.ndarray) -> None: ...
 
+    @property
+    def near_points(self) -> np.ndarray:
+        """(N, 2) floor points the scanner sensed near the robot, not furniture, as of the last scan."""
+        ...
+
 
 class RobotController:
     """Base driver, joint references and grippers of one robot."""

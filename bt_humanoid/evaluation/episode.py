@@ -67,6 +67,8 @@ class Draw:
         if kinds and rng.uniform() < suite.faults.share:
             self.fault_index = index % kinds if suite.faults.order == "cycle" else int(rng.integers(kinds))
         self.side_sign = float(rng.choice([-1.0, 1.0]))
+        #: the fault's strengths (a span's value): a stream of their own, so the scene draws stay as they were
+        self.fault_rng = np.random.default_rng([suite.seed, index, 1])
         self.spare_spots: list[np.ndarray] = []  # filled at set-up: where a moved object may go
 
     @property
@@ -336,9 +338,11 @@ def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:
     if kind == "obstacle_dropped":
         return fault_kinds.ObstacleDropped(run, settings)
     if kind == "push":
-        return fault_kinds.Push(run, settings, draw.side_sign)
+        return fault_kinds.Push(run, settings, draw.side_sign, draw.fault_rng)
+    if kind == "arm_bump":
+        return fault_kinds.ArmBump(run, draw.obj, settings, draw.side_sign, draw.fault_rng)
     if kind == "blind":
-        return fault_kinds.Blind(run, settings)
+        return fault_kinds.Blind(run, settings, draw.fault_rng)
     if kind == "new_command":
         return fault_kinds.NewCommand(run, fill(settings.command, draw.slots), settings)
     raise AssertionError(f"no injector for {kind}")

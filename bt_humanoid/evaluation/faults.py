@@ -2,12 +2,14 @@
 
 Each kind has a settings model (what a suite or a test writes, e.g.
 ``- push: {force: 250}``) and an injector that watches the run after every
-control step and fires once, when its moment comes:
+control step and fires once, when its moment comes. A strength may be a span,
+``[low, high]``: each episode draws its own from its fault stream.
 
 - ``slip``: the object's surface turns slippery just after it is lifted, so it slides out of the fingers;
 - ``target_moved``: someone moves the object to another spot while the robot drives towards it;
 - ``obstacle_dropped``: a box lands on the floor in front of the robot while it drives;
 - ``push``: someone shoves the robot sideways while it drives;
+- ``arm_bump``: someone walking past knocks the arm that carries something, while the robot drives;
 - ``blind``: the head camera delivers no frames (colour and depth) for some seconds;
 - ``new_command``: a new command arrives mid-mission; the robot stops and does that instead.
 
@@ -37,6 +39,14 @@ DRIVING = 0.15  # m/s of base speed above which the robot counts as driving
 SPARE_BOX = "parcel"  # the free box in a corner of the apartment that obstacle_dropped drops on the robot's way
 
 
+Span = float | tuple[float, float]  # one value, or [low, high] to draw from per episode
+
+
+def pick(span: Span, rng: np.random.Generator) -> float:
+    """The value of ``span`` for one episode: itself, or drawn uniformly from [low, high]."""
+    return float(rng.uniform(*span)) if isinstance(span, tuple) else float(span)
+
+
 class SlipSettings(StrictModel):
     friction: float = Field(0.02, gt=0, le=1, description="the object's friction while slippery")
     seconds: float = Field(1.0, gt=0, le=10, description="how long it stays slippery (at most: until it is out)")
@@ -53,13 +63,34 @@ class ObstacleDroppedSettings(StrictModel):
 
 
 class PushSettings(StrictModel):
-    force: float = Field(250.0, gt=0, le=2000, description="N, sideways on the base")
-    seconds: float = Field(0.3, gt=0, le=2, description="how long the shove lasts")
+    # a person's shove on a standing adult is 40-80 N·s (issue 26); MuJoCo's xfrc_applied acts on the base link
+    impulse: Span = Field(60.0, description="N·s sideways on the base: a number, or [low, high] drawn per episode")
+    seconds: float = Field(0.3, gt=0, le=2, description="how long the shove lasts (force = impulse / seconds)")
+
+    @model_validator(mode="after")
+    def _positive(self) -> PushSettings:
+        _check_span(self.impulse, "impulse", 0.0, 1000.0)
+        return self
+
+
+class ArmBumpSettings(StrictModel):
+    impulse: Span = Field(6.0, description="N·s on the carrying hand: a number, or [low, high] drawn per episode")
+    seconds: float = Field(0.15, gt=0, le=1, description="how long the knock lasts (force = impulse / seconds)")
+
+    @model_validator(mode="after")
+    def _positive(self) -> ArmBumpSettings:
+        _check_span(self.impulse, "impulse", 0.0, 100.0)
+        return self
 
 
 class BlindSettings(StrictModel):
-    seconds: float = Field(4.0, gt=0, le=60, description="how long the camera delivers no frames")
+    seconds: Span = Field(4.0, description="how long the camera delivers no frames: a number, or [low, high]")
     after: float = Field(1.0, ge=0, le=600, description="s into the mission when it starts")
+
+    @model_validator(mode="after")
+    def _positive(self) -> BlindSettings:
+        _check_span(self.seconds, "seconds", 0.0, 60.0)
+        return self
 
 
 class NewCommandSettings(StrictModel):
@@ -68,11 +99,18 @@ class NewCommandSettings(StrictModel):
     after: float = Field(8.0, ge=0, le=600, description="s into the mission when it arrives")
 
 
+def _check_span(span: Span, name: str, above: float, most: float) -> None:
+    low, high = span if isinstance(span, tuple) else (span, span)
+    if not above < low <= high <= most:
+        raise ValueError(f"{name} must lie in ({above:g}, {most:g}], low before high: got {span}")
+
+
 FAULT_MODELS: dict[str, type[StrictModel]] = {
     "slip": SlipSettings,
     "target_moved": TargetMovedSettings,
     "obstacle_dropped": ObstacleDroppedSettings,
     "push": PushSettings,
+    "arm_bump": ArmBumpSettings,
     "blind": BlindSettings,
     "new_command": NewCommandSettings,
 }
@@ -85,6 +123,7 @@ class FaultConfig(StrictModel):
     target_moved: TargetMovedSettings | None = None
     obstacle_dropped: ObstacleDroppedSettings | None = None
     push: PushSettings | None = None
+    arm_bump: ArmBumpSettings | None = None
     blind: BlindSettings | None = None
     new_command: NewCommandSettings | None = None
 
@@ -251,46 +290,78 @@ class ObstacleDropped(Injector):
         return all(np.hypot(*(spot - other)) >= PLACE_CLEARANCE for other in keep_clear)
 
 
-class Push(Injector):
-    kind = "push"
+class _Shove(Injector):
+    """A force on one of the robot's bodies, sideways to its heading, for ``seconds``: impulse / seconds."""
 
-    def __init__(self, run: MissionRun, settings: PushSettings, sign: float) -> None:
+    def __init__(self, run: MissionRun, impulse: float, seconds: float, sign: float) -> None:
         super().__init__(run)
-        self.settings, self.sign = settings, sign
-        self.base = run.sim.model.body(run.sim.robot_root).id
+        self.impulse, self.seconds, self.sign = impulse, seconds, sign
+        self.body: int | None = None
         self.released = False
 
-    def watch(self) -> None:
-        if not self.driving():
-            return
+    def shove(self, body: int, what: str) -> None:
         _, _, yaw = self.run.truth.robot_pose()
         sideways = self.sign * np.array([-math.sin(yaw), math.cos(yaw), 0.0])
-        self.run.sim.data.xfrc_applied[self.base, :3] = self.settings.force * sideways
-        self.fire(f"pushed {'left' if self.sign > 0 else 'right'} with {self.settings.force:.0f} N")
+        self.body = body
+        self.run.sim.data.xfrc_applied[body, :3] = self.impulse / self.seconds * sideways
+        side = "left" if self.sign > 0 else "right"
+        self.fire(f"{what} {side}: {self.impulse:.0f} N·s over {self.seconds:.2f} s")
 
     def after(self) -> None:
-        if not self.released and self.run.sim.time > self.fired.time + self.settings.seconds:
-            self.run.sim.data.xfrc_applied[self.base, :3] = 0.0
+        if not self.released and self.run.sim.time > self.fired.time + self.seconds:
+            self.run.sim.data.xfrc_applied[self.body, :3] = 0.0
             self.released = True
+
+
+class Push(_Shove):
+    kind = "push"
+
+    def __init__(self, run: MissionRun, settings: PushSettings, sign: float, rng: np.random.Generator) -> None:
+        super().__init__(run, pick(settings.impulse, rng), settings.seconds, sign)
+
+    def watch(self) -> None:
+        if self.driving():
+            self.shove(self.run.sim.model.body(self.run.sim.robot_root).id, "pushed")
+
+
+class ArmBump(_Shove):
+    """Someone walking past knocks the hand that carries the episode's object, while the robot drives."""
+
+    kind = "arm_bump"
+
+    def __init__(
+        self, run: MissionRun, obj: str, settings: ArmBumpSettings, sign: float, rng: np.random.Generator
+    ) -> None:
+        super().__init__(run, pick(settings.impulse, rng), settings.seconds, sign)
+        self.obj = obj
+
+    def watch(self) -> None:
+        side = self.run.truth.in_hand(self.obj)
+        if side is None or not self.driving():
+            return
+        model = self.run.sim.model
+        hand = int(model.site_bodyid[model.site(self.run.context.robot_config.grippers[side].grip_site).id])
+        self.shove(hand, f"the {side} hand carrying the {self.obj} was knocked")
 
 
 class Blind(Injector):
     kind = "blind"
 
-    def __init__(self, run: MissionRun, settings: BlindSettings) -> None:
+    def __init__(self, run: MissionRun, settings: BlindSettings, rng: np.random.Generator) -> None:
         super().__init__(run)
         self.settings = settings
+        self.seconds = pick(settings.seconds, rng)
         self.start = run.sim.time + settings.after
 
     def watch(self) -> None:
         if self.run.sim.time < self.start:
             return
-        until = self.run.sim.time + self.settings.seconds
+        until = self.run.sim.time + self.seconds
         if self.run.perceiver is not None:
             self.run.perceiver.camera.dropped_until = until
         if self.run.navigator.camera is not None:
             self.run.navigator.camera.dropped_until = until
-        self.fire(f"the head camera gave no frames for {self.settings.seconds:.0f} s")
+        self.fire(f"the head camera gave no frames for {self.seconds:.1f} s")
 
 
 class NewCommand(Injector):

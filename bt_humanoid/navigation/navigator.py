@@ -44,6 +44,9 @@ CREEP_SPEED = 0.1  # m/s
 MAX_GAZE_PAN = 1.0  # rad the head turns from the heading at most
 LOOKAHEAD = 2.5  # m of route ahead checked against the map at every update
 MAX_REPLANS = 30  # per goal, before the goal fails as blocked
+# s a protective stop holds the base before what the base scanner senses near it goes on the map: the head camera
+# looks along the route and may never see a low thing beside the base (a box dropped there held the robot 10 s)
+HELD_REMAP = 1.0
 WAIT_LIMIT = 15.0  # s to wait, stopped, for a blocked way to clear before the goal fails
 FREE_SAMPLES = 12  # points along the low end of each ray that mark free cells
 # m a robot standing nearer furniture than its footprint allows a route to start (a biped works 0.25 m from a
@@ -87,6 +90,7 @@ class Navigator:
         self.stepping_out = False  # backing straight out of a working stance before the first plan
         self.waiting_since: float | None = None  # stopped because no route is free now
         self.resume_tilt: float | None = None  # the head's tilt before a wait (it looks down at the goal meanwhile)
+        self.remapped_hold: float | None = None  # the protective stop whose sensed things went on the map
 
     def remap(self) -> None:
         """Build the floor plan from the furniture where it stands now (at start, or after it was rearranged)."""
@@ -170,6 +174,11 @@ class Navigator:
                 self._look_along_route()
         if self.handle is None:
             return
+        if self._held_by_the_unseen(now):
+            self.follower.stop()
+            self._plan_and_follow()  # backing out first, when it stands too near what it now knows of to plan
+            if self.handle is None:
+                return
         if self.waiting_since is not None:
             self.handle.feedback = f"waiting for the way to clear ({now - self.waiting_since:.0f} s)"
             return
@@ -328,6 +337,28 @@ class Navigator:
             self.follower.stop()
         self.goal = None
 
+    def _held_by_the_unseen(self, now: float) -> bool:
+        """Whether a protective stop has held the base for HELD_REMAP s; if so, what the base scanner senses near
+        the robot goes on the map (once per hold), so that the next route goes round it."""
+        held, separation = self.robot.base.held_since, self.robot.separation
+        if held is None or separation is None or now - held < HELD_REMAP or self.remapped_hold == held:
+            return False
+        self.remapped_hold = held
+        sensed = separation.near_points
+        if not len(sensed):
+            return False
+        self._mark_seen(sensed, self.robot.base.pose()[:2], now)
+        return True
+
+    def _mark_seen(self, solid: np.ndarray, origin: np.ndarray, now: float) -> None:
+        """Put floor points a sensor at ``origin`` hit on the map; it sees only the near face of a thing, so the
+        thing is assumed SEEN_DEPTH deep along the ray."""
+        away = solid - origin[:2]
+        away /= np.maximum(np.hypot(*away.T), 1e-6)[:, None]
+        depths = np.arange(0.0, SEEN_DEPTH + 1e-9, self.grid.resolution)
+        behind = solid[:, None, :] + depths[None, :, None] * away[:, None, :]
+        self.grid.mark(behind.reshape(-1, 2), now)
+
     def _update_map(self) -> None:
         """Add what the depth camera sees, clear what it sees free."""
         if self.camera is None:
@@ -345,14 +376,8 @@ class Navigator:
         rows, cols = self.grid.cell(hits[:, :2])
         inside = self.grid.inside(rows, cols)
         keep[inside] &= ~self._near_static[rows[inside], cols[inside]]  # the map already knows it
-        solid = hits[keep][:, :2]
-        # the camera sees only the near face of a thing: assume it is SEEN_DEPTH deep along the ray
-        away_from_camera = solid - scan.origin[:2]
-        away_from_camera /= np.maximum(np.hypot(*away_from_camera.T), 1e-6)[:, None]
-        depths = np.arange(0.0, SEEN_DEPTH + 1e-9, self.grid.resolution)
-        behind = solid[:, None, :] + depths[None, :, None] * away_from_camera[:, None, :]
         now = self.robot.base.time
-        self.grid.mark(behind.reshape(-1, 2), now)
+        self._mark_seen(hits[keep][:, :2], scan.origin, now)
         self.grid.forget_older_than(now - OBSERVED_MEMORY)
         rows, cols = self._cells_seen_free(scan)
         self.grid.clear(rows, cols)

@@ -78,6 +78,11 @@ class SpeedAndSeparation:
         self.distance = float(gaps.min()) if gaps.size else np.inf
         self._update_zone()
 
+    @property
+    def near_points(self) -> np.ndarray:
+        """(N, 2) what the scanner sensed within the slow zone of a part, not furniture (map frame, last scan)."""
+        return self._points
+
     def share(self, velocity: np.ndarray) -> float:
         """The share (0 to 1) of a base velocity (vx, vy, yaw rate; world frame) that keeps the closing speeds.
 
