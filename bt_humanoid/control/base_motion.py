@@ -17,6 +17,7 @@ from bt_humanoid.control.motion import MotionHandle
 @runtime_checkable
 class BaseMotion(Protocol):
     speed_cap: float  # m/s: the mission's cap, set once per run; every motion plans under it
+    held_since: float | None  # when a protective stop began holding the motion now running; None while free
 
     @property
     def time(self) -> float:

@@ -23,11 +23,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import mujoco
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import AfterValidator, Field, model_validator
 
 from bt_humanoid.strict_model import StrictModel, exactly_one
 
@@ -40,6 +40,21 @@ SPARE_BOX = "parcel"  # the free box in a corner of the apartment that obstacle_
 
 
 Span = float | tuple[float, float]  # one value, or [low, high] to draw from per episode
+
+
+def _span_within(most: float) -> Any:
+    """A Span type whose values lie in (0, ``most``], low before high."""
+
+    def check(span: Span) -> Span:
+        low, high = span if isinstance(span, tuple) else (span, span)
+        if not 0.0 < low <= high <= most:
+            raise ValueError(f"must lie in (0, {most:g}], low before high: got {span}")
+        return span
+
+    return Annotated[Span, AfterValidator(check)]
+
+
+SpanUpTo60, SpanUpTo100, SpanUpTo1000 = _span_within(60.0), _span_within(100.0), _span_within(1000.0)
 
 
 def pick(span: Span, rng: np.random.Generator) -> float:
@@ -64,45 +79,24 @@ class ObstacleDroppedSettings(StrictModel):
 
 class PushSettings(StrictModel):
     # a person's shove on a standing adult is 40-80 N·s (issue 26); MuJoCo's xfrc_applied acts on the base link
-    impulse: Span = Field(60.0, description="N·s sideways on the base: a number, or [low, high] drawn per episode")
+    impulse: SpanUpTo1000 = Field(60.0, description="N·s sideways on the base: a number, or [low, high]")
     seconds: float = Field(0.3, gt=0, le=2, description="how long the shove lasts (force = impulse / seconds)")
-
-    @model_validator(mode="after")
-    def _positive(self) -> PushSettings:
-        _check_span(self.impulse, "impulse", 0.0, 1000.0)
-        return self
 
 
 class ArmBumpSettings(StrictModel):
-    impulse: Span = Field(6.0, description="N·s on the carrying hand: a number, or [low, high] drawn per episode")
+    impulse: SpanUpTo100 = Field(6.0, description="N·s on the carrying hand: a number, or [low, high]")
     seconds: float = Field(0.15, gt=0, le=1, description="how long the knock lasts (force = impulse / seconds)")
-
-    @model_validator(mode="after")
-    def _positive(self) -> ArmBumpSettings:
-        _check_span(self.impulse, "impulse", 0.0, 100.0)
-        return self
 
 
 class BlindSettings(StrictModel):
-    seconds: Span = Field(4.0, description="how long the camera delivers no frames: a number, or [low, high]")
+    seconds: SpanUpTo60 = Field(4.0, description="how long the camera delivers no frames: a number, or [low, high]")
     after: float = Field(1.0, ge=0, le=600, description="s into the mission when it starts")
-
-    @model_validator(mode="after")
-    def _positive(self) -> BlindSettings:
-        _check_span(self.seconds, "seconds", 0.0, 60.0)
-        return self
 
 
 class NewCommandSettings(StrictModel):
     command: str = Field(description="what the person says; {object} and {surface} are filled per episode")
     expect: list[dict[str, Any]] = Field(description="success conditions of the new command")
     after: float = Field(8.0, ge=0, le=600, description="s into the mission when it arrives")
-
-
-def _check_span(span: Span, name: str, above: float, most: float) -> None:
-    low, high = span if isinstance(span, tuple) else (span, span)
-    if not above < low <= high <= most:
-        raise ValueError(f"{name} must lie in ({above:g}, {most:g}], low before high: got {span}")
 
 
 FAULT_MODELS: dict[str, type[StrictModel]] = {
