@@ -43,8 +43,10 @@ def test_the_fetch_suite_meets_the_issue_s_shape():
     assert suite.episodes >= 200
     assert len(set(suite.objects)) >= 3
     assert suite.faults.share >= 0.2
-    kinds = {fault.kind for fault in suite.faults.kinds}
-    assert kinds == {"slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command"}
+    faults = {fault.kind: fault.settings for fault in suite.faults.kinds}
+    assert set(faults) == {"slip", "target_moved", "obstacle_dropped", "push", "arm_bump", "blind", "new_command"}
+    assert faults["push"].impulse == (40.0, 80.0)  # N·s: issue 26's shoves
+    assert faults["blind"].seconds == (5.0, 10.0)
 
 
 def test_draws_follow_from_the_seed_and_index_alone():
