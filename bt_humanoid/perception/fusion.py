@@ -135,11 +135,7 @@ def _fold(belief: WorldModel, younger: TrackedObject, older: TrackedObject) -> N
     older.confidence = max(older.confidence, younger.confidence)
     older.last_seen = max(older.last_seen, younger.last_seen)
     _vote(older)
-    del belief.objects[younger.id]
-    belief.merged[younger.id] = older.id
-    for key, into in belief.merged.items():
-        if into == younger.id:
-            belief.merged[key] = older.id
+    _retire(belief, younger.id, older.id)
 
 
 def _reidentify(belief: WorldModel) -> None:
@@ -189,11 +185,16 @@ def _take_over(belief: WorldModel, old: TrackedObject, new: TrackedObject) -> No
         setattr(old, name, getattr(new, name))
     old.votes = votes
     _vote(old)
-    del belief.objects[new.id]
-    belief.merged[new.id] = old.id
-    for key, into in belief.merged.items():
-        if into == new.id:
-            belief.merged[key] = old.id
+    _retire(belief, new.id, old.id)
+
+
+def _retire(belief: WorldModel, key: str, into: str) -> None:
+    """Track ``key`` is now ``into``: gone from the objects, and every id that named it names ``into``."""
+    del belief.objects[key]
+    belief.merged[key] = into
+    for merged, target in belief.merged.items():
+        if target == key:
+            belief.merged[merged] = into
 
 
 def _new(belief: WorldModel, detection: Detection, time: float, distance: float) -> TrackedObject:
