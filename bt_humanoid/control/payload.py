@@ -29,12 +29,11 @@ class WristScale:
     def __init__(self, config: RobotConfig, io: MujocoRobotIO, dynamics: RobotDynamics) -> None:
         self.io = io
         self.dynamics = dynamics
-        model = io.sim.model
         #: side -> (force sensor, the frame it measures in, the grip site)
         self.sensors = {
             side: (
                 gripper.wrist_force,
-                model.site(int(model.sensor(gripper.wrist_force).objid[0])).name,
+                io.sensor_site(gripper.wrist_force),
                 gripper.grip_site,
             )
             for side, gripper in config.grippers.items()

@@ -97,9 +97,7 @@ class RobotController:
         reading = self.body_io.sensor(sensor).copy()
         if not in_world:
             return reading
-        model = self.body_io.sim.model
-        frame = model.site(int(model.sensor(sensor).objid[0])).name
-        return self.whole_body.frame_pose(frame).rotation @ reading
+        return self.whole_body.frame_pose(self.body_io.sensor_site(sensor)).rotation @ reading
 
     def set_control_period(self, period: float) -> None:
         """Seconds between ``step()`` calls: the whole-body QP integrates its step over this."""

@@ -80,6 +80,11 @@ class MujocoRobotIO:
             limit = np.inf
         return float(model.actuator_gainprm[actuator, 0]), float(-model.actuator_biasprm[actuator, 2]), limit
 
+    def sensor_site(self, name: str) -> str:
+        """The site a sensor measures at (a force sensor's frame: its readings are in that site's axes)."""
+        model = self.sim.model
+        return model.site(int(model.sensor(name).objid[0])).name
+
     def sensor(self, name: str) -> np.ndarray:
         """A sensor's reading (the robot's IMU, foot force and touch sensors), as of the last physics step; the IMU's
         rates and specific force with its white noise."""
