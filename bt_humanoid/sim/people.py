@@ -47,6 +47,7 @@ REACH = (0.3, 0.5)
 HEIGHTS = (0.6, 1.5)  # m above the floor
 STILL = 0.03  # m/s: a thing offered is held still ...
 STILL_FOR = 0.5  # s ... for this long before they reach
+STANDS_OUT = 0.02  # m off a thing's middle, across the floor, where a part of it is a handle to close along
 HAND_SPEED = 0.3  # m/s their hand moves at ...
 TURN_RATE = 1.5  # rad/s ... and turns at
 TURNED = 0.05  # rad: the arm turns to the thing first, low, to within this ...
@@ -292,10 +293,10 @@ class PersonDriver:
         side, and neither lands on its flank; of a box, its side most nearly facing them; of anything else round,
         the way they look at it."""
         geoms = np.flatnonzero(self.model.geom_bodyid == body)
-        if len(geoms) > 1:
-            outwards = self.data.geom_xpos[geoms, :2] - self.data.xpos[body][:2]
-            part = outwards[int(np.argmax(np.hypot(outwards[:, 0], outwards[:, 1])))]
-            across = np.array([-part[1], part[0]]) / max(float(np.hypot(*part)), 1e-9)
+        outwards = self.data.geom_xpos[geoms, :2] - self.data.xpos[body][:2]
+        part = outwards[int(np.argmax(np.hypot(outwards[:, 0], outwards[:, 1])))]
+        if float(np.hypot(*part)) > STANDS_OUT:  # (a bottle's cap, above its middle, stands out from nothing)
+            across = np.array([-part[1], part[0]]) / float(np.hypot(*part))
             return across if float(across @ towards) >= 0.0 else -across
         if self.model.geom_type[geoms[0]] != mujoco.mjtGeom.mjGEOM_BOX:
             return towards
