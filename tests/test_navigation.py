@@ -382,3 +382,43 @@ def test_what_a_hand_holds_is_not_put_on_the_map_even_where_it_rises_above_the_g
     assert not observed[navigator.grid.cell(points[:2, :2])].any()  # what the hand holds
     assert observed[navigator.grid.cell(points[2:, :2])].all()  # what stands half a metre from it
     navigator.grid.clear_observed()
+
+
+def _kitchen_taken(run) -> np.ndarray:
+    """Mark 40 cm of what the camera saw round the kitchen place, as a parcel dropped there would be."""
+    kitchen = np.array(run.context.world.places["kitchen"].pose)
+    xs, ys = np.meshgrid(np.arange(-0.2, 0.2, 0.05), np.arange(-0.2, 0.2, 0.05))
+    run.navigator.grid.mark(kitchen[:2] + np.stack([xs.ravel(), ys.ravel()], axis=1), now=0.0)
+    return np.array([kitchen[0], kitchen[1], math.radians(kitchen[2])])
+
+
+def test_a_goal_something_seen_stands_on_is_chosen_again_where_there_is_room():
+    """A parcel on a stance: the navigator asks for the goal afresh and drives to the answer, instead of waiting
+    15 s for the parcel to go (seed 2's episode 123, a stance chosen before the parcel was seen)."""
+    run = build_run({"mission": "to the kitchen", "tree": {"wait": {"seconds": 0}}})
+    navigator = run.navigator
+    goal = _kitchen_taken(run)
+    beside = goal + np.array([0.0, -1.0, 0.0])
+    asked: list[float] = []
+    handle = navigator.go_to(goal, choose_goal=lambda: asked.append(1.0) or beside)
+    try:
+        assert asked, "the goal was chosen again"
+        assert np.allclose(navigator.goal, beside)
+        assert navigator.waiting_since is None and not handle.done and navigator.route is not None
+    finally:
+        navigator.halt()
+        run.stack.close()
+
+
+def test_a_goal_chosen_again_is_kept_when_the_answer_has_no_more_room_and_the_robot_waits():
+    run = build_run({"mission": "to the kitchen", "tree": {"wait": {"seconds": 0}}})
+    navigator = run.navigator
+    goal = _kitchen_taken(run)
+    nearby = goal + np.array([0.05, 0.0, 0.0])  # as taken
+    navigator.go_to(goal, choose_goal=lambda: nearby)
+    try:
+        assert np.allclose(navigator.goal, goal)
+        assert navigator.waiting_since is not None, "blocked only by what was seen: it waits"
+    finally:
+        navigator.halt()
+        run.stack.close()

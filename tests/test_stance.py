@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from bt_humanoid.control.stance import MAX_DEPTH, StanceError, deepest_reach, working_stance
+from bt_humanoid.control.stance import MAX_DEPTH, StanceError, deepest_reach, working_stance, working_stances
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.sim.robot_config import load_robot_config
 
@@ -81,3 +81,15 @@ def test_a_shift_to_the_left_moves_the_stance_along_the_edge_by_as_much():
     x0, y0, _ = working_stance(spot, TABLE, "right", base, BOUNDS, SOUTH)
     x1, y1, _ = working_stance(spot, TABLE, "right", base, BOUNDS, SOUTH, shift=(0.0, -0.04))
     assert (x1, y1) == pytest.approx((x0 + 0.04, y0))  # facing north, its left is west: 4 cm to its right is east
+
+
+def test_every_edge_that_reaches_a_spot_gives_a_stance_nearest_the_robot_first():
+    """A spot near the table's south-west corner is reached from the south and the west edges: the nearer to the
+    robot comes first, the other is where to work from when something stands on the first."""
+    base = load_robot_config("wheeled_humanoid").base
+    spot = np.array([1.95, -0.3])
+    from_south = working_stances(spot, TABLE, "right", base, BOUNDS, SOUTH)
+    assert [round(yaw, 3) for _, _, yaw in from_south] == [round(math.pi / 2, 3), 0.0]
+    assert working_stance(spot, TABLE, "right", base, BOUNDS, SOUTH) == from_south[0]
+    from_west = working_stances(spot, TABLE, "right", base, BOUNDS, np.array([0.0, -0.3]))
+    assert [yaw for _, _, yaw in from_west] == [0.0, pytest.approx(math.pi / 2)]

@@ -46,6 +46,38 @@ def stance_for(
 
     Of the edges that reach the spot, the one whose stance is nearest the robot wins.
     """
+    return stances_for(
+        spot,
+        surface,
+        side,
+        footprint_radius,
+        bounds,
+        robot_xy,
+        standoff,
+        max_depth,
+        hand_lateral,
+        closest,
+        nearer,
+        aside,
+    )[0]
+
+
+def stances_for(
+    spot: np.ndarray,
+    surface: SupportSurface,
+    side: str,
+    footprint_radius: float,
+    bounds: np.ndarray,
+    robot_xy: np.ndarray,
+    standoff: float | None = None,
+    max_depth: float = MAX_DEPTH,
+    hand_lateral: float = HAND_LATERAL,
+    closest: float | None = None,
+    nearer: float = 0.0,
+    aside: float = 0.0,
+) -> list[tuple[float, float, float]]:
+    """Every stance of ``stance_for``, one per edge that reaches the spot, nearest the robot first: the next
+    ones are where to work from when something stands on the first."""
     (x0, y0), (x1, y1) = surface.region
     x, y = float(spot[0]), float(spot[1])
     standoff = footprint_radius + EDGE_CLEARANCE if standoff is None else standoff
@@ -67,16 +99,14 @@ def stance_for(
     if not options:
         raise StanceError(f"no room to stand beside the {surface.name}")
     reachable = [option for option in options if option[0] <= reach]
-    if reachable:
-        depth, stance, yaw = min(reachable, key=lambda option: float(np.linalg.norm(option[1] - robot_xy)))
-    else:
-        depth, stance, yaw = min(options, key=lambda option: option[0])
-    if depth > reach:
+    if not reachable:
+        depth = min(option[0] for option in options)
         raise StanceError(
             f"spot ({x:.2f}, {y:.2f}) is {depth:.2f} m behind the nearest free edge of the {surface.name}; "
             f"the arm reaches {reach:.2f} m"
         )
-    return float(stance[0]), float(stance[1]), yaw
+    reachable.sort(key=lambda option: float(np.linalg.norm(option[1] - robot_xy)))
+    return [(float(stance[0]), float(stance[1]), yaw) for _, stance, yaw in reachable]
 
 
 def working_stance(
@@ -90,8 +120,21 @@ def working_stance(
 ) -> tuple[float, float, float]:
     """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml), moved by ``shift`` (m
     ahead, nearer the edge where its ``closest`` allows; m to the left)."""
+    return working_stances(spot, surface, side, base, bounds, robot_xy, shift)[0]
+
+
+def working_stances(
+    spot: np.ndarray,
+    surface: SupportSurface,
+    side: str,
+    base: BaseConfig,
+    bounds: np.ndarray,
+    robot_xy: np.ndarray,
+    shift: tuple[float, float] = (0.0, 0.0),
+) -> list[tuple[float, float, float]]:
+    """``stances_for`` where the robot's own ``base.working_stance`` says: one per edge, nearest first."""
     stance = base.working_stance
-    return stance_for(
+    return stances_for(
         spot,
         surface,
         side,

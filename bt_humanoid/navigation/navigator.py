@@ -12,6 +12,7 @@ is tree structure in behaviors/navigate.yaml.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import cv2
 import numpy as np
@@ -47,6 +48,9 @@ MAX_REPLANS = 30  # per goal, before the goal fails as blocked
 # s a protective stop holds the base before what the base scanner senses near it goes on the map: the head camera
 # looks along the route and may never see a low thing beside the base (a box dropped there held the robot 10 s)
 HELD_REMAP = 1.0
+# new goals a goal may be swapped for when what the camera saw stands on it (a parcel on a stance, a person nearer
+# than the stance by them allows): each is chosen afresh on the map as it is then
+GOAL_RECHOICES = 5
 WAIT_LIMIT = 15.0  # s to wait, stopped, for a blocked way to clear before the goal fails
 FREE_SAMPLES = 12  # points along the low end of each ray that mark free cells
 # m a robot standing nearer furniture than its footprint allows a route to start (a biped works 0.25 m from a
@@ -91,6 +95,8 @@ class Navigator:
         self.waiting_since: float | None = None  # stopped because no route is free now
         self.resume_tilt: float | None = None  # the head's tilt before a wait (it looks down at the goal meanwhile)
         self.remapped_hold: float | None = None  # the protective stop whose sensed things went on the map
+        self.choose_goal: Callable[[], np.ndarray] | None = None  # the goal chosen afresh, when seen things take it
+        self.goals_chosen = 0  # of GOAL_RECHOICES
 
     def remap(self) -> None:
         """Build the floor plan from the furniture where it stands now (at start, or after it was rearranged)."""
@@ -105,13 +111,21 @@ class Navigator:
 
     # ------------------------------------------------------------------ goals
 
-    def go_to(self, goal: np.ndarray, max_speed: float | None = None) -> MotionHandle:
+    def go_to(
+        self,
+        goal: np.ndarray,
+        max_speed: float | None = None,
+        choose_goal: Callable[[], np.ndarray] | None = None,
+    ) -> MotionHandle:
         """Plan to ``goal`` (x, y, yaw) and follow the route at up to ``max_speed`` (None: as fast as the mission's
-        cap allows); the handle fails with the reason if there is none."""
+        cap allows); the handle fails with the reason if there is none. ``choose_goal``, when given, picks the
+        goal again on the map as it is now: it is asked when something the camera saw stands where the goal is
+        (the goal is kept if the answer has no more room)."""
         self._finish_goal("pre-empted by a new goal")
         if self.follower.dt != self.robot.control_period:  # the executor chose the control rate after we were built
             self.follower = RouteFollower(self.robot.base, self.robot.config.base, self.robot.control_period)
         self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), self.robot.base.capped(max_speed), 0
+        self.choose_goal, self.goals_chosen = choose_goal, 0
         self.waiting_since = None
         self.stepping_out = False
         handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
@@ -208,7 +222,7 @@ class Navigator:
         if self._step_out():
             return
         try:
-            route = self._plan()
+            route = self._plan_or_choose_again()
         except PlanError as error:
             if self._blocked_only_by_what_was_seen():  # a person on the way or at the goal may walk on: wait
                 self._wait(self.robot.base.time)
@@ -217,6 +231,32 @@ class Navigator:
             return
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
+
+    def _plan_or_choose_again(self) -> Route:
+        """Plan; where something the camera saw stands on the goal itself, plan to a goal chosen afresh."""
+        try:
+            return self._plan()
+        except PlanError:
+            if not self._choose_goal_again():
+                raise
+            return self._plan()
+
+    def _choose_goal_again(self) -> bool:
+        """Swap the goal for ``choose_goal``'s answer where only what the camera saw leaves the goal too little
+        room and the answer has enough; False (keep it: wait for the way to clear) otherwise."""
+        if self.choose_goal is None or self.goal is None or self.goals_chosen >= GOAL_RECHOICES:
+            return False
+        minimum = self.clearance.minimum
+        if self.grid.clearance_at(self.goal[None, :2])[0] >= minimum:
+            return False  # the goal has room: the way to it is what is blocked
+        if self.grid.without_observed().clearance_at(self.goal[None, :2])[0] < minimum:
+            return False  # furniture, not something seen: choosing again would not help
+        goal = np.asarray(self.choose_goal(), dtype=float)
+        if np.allclose(goal[:2], self.goal[:2], atol=1e-3) or self.grid.clearance_at(goal[None, :2])[0] < minimum:
+            return False
+        self.goal = goal
+        self.goals_chosen += 1
+        return True
 
     def _blocked_only_by_what_was_seen(self) -> bool:
         """Whether the map alone, without what the camera added, has a route to the goal."""
@@ -252,7 +292,7 @@ class Navigator:
                 self._finish_goal(f"the way kept getting blocked: {MAX_REPLANS} new routes taken", brake=True)
                 return
         try:
-            route = self._plan()
+            route = self._plan_or_choose_again()
         except PlanError as error:
             if self.waiting_since is None:
                 self._wait(now)

@@ -8,13 +8,14 @@ up, clear costmap); behaviors/navigate.yaml composes them.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 from pydantic import Field, model_validator
 
 from bt_humanoid.control.motion import MotionHandle
-from bt_humanoid.control.stance import StanceError, working_stance
+from bt_humanoid.control.stance import StanceError, working_stances
 from bt_humanoid.skills.context import CheckContext, SkillContext
 from bt_humanoid.skills.manipulation_skills import TUCKED_POSTURE, lift_what_is_held
 from bt_humanoid.skills.params import check_in_map, check_name, check_object
@@ -28,6 +29,7 @@ PERSON_STANDOFF = 0.6  # m between the footprint and a person: arm's length, to 
 FACING_TURNS = 120  # degrees either side of the robot's own direction where a pose facing someone may be
 FACING_EXTRA = 0.15  # m further off, when no pose at arm's length leaves the base room
 STANCE_BACKOFF = 0.35  # m behind the stance for working on an object on a surface
+STANCE_ASIDE = (0.2, -0.2, 0.4, -0.4)  # m to the left along the edge, where something stands behind the stance
 BACK_UP_SPEED = 0.2  # m/s
 
 
@@ -122,7 +124,7 @@ class NavigateTo(_BaseSkill):
     def _navigate(self) -> MotionHandle:
         navigator = self._navigator()
         goal, what = self._goal()
-        handle = navigator.go_to(goal, self.params.max_speed)
+        handle = navigator.go_to(goal, self.params.max_speed, choose_goal=lambda: self._goal_again(goal))
         if handle.done and handle.result:
             raise PhaseFailure(f"{what}: {handle.result}")
         self.what = what
@@ -145,6 +147,13 @@ class NavigateTo(_BaseSkill):
         if p.person is not None:
             return self._facing(self._person(p.person), PERSON_STANDOFF), f"the {p.person}"
         return self._standoff(p.object), f"the {p.object}"
+
+    def _goal_again(self, goal: np.ndarray) -> np.ndarray:
+        """The goal chosen on the navigator's map as it is now (``goal`` where it can no longer be chosen)."""
+        try:
+            return self._goal()[0]
+        except PhaseFailure:
+            return goal
 
     def _person(self, name: str) -> np.ndarray:
         try:
@@ -182,20 +191,33 @@ class NavigateTo(_BaseSkill):
         if surface is not None:
             bounds = np.array(self.context.world.bounds)
             try:
-                x, y, yaw = working_stance(obj.position[:2], surface, "right", config.base, bounds, here[:2])
+                stances = working_stances(obj.position[:2], surface, "right", config.base, bounds, here[:2])
             except StanceError as error:
                 raise PhaseFailure(str(error)) from None
             # a step back from the working stance: room to raise the arms before the last approach (stand_near),
-            # shorter where furniture behind leaves less room
-            back = np.array([math.cos(yaw), math.sin(yaw)])
-            options = [np.array([x, y]) - step * back for step in np.linspace(STANCE_BACKOFF, 0.0, 5)]
+            # shorter where furniture behind leaves less room; to a side of it, or at the next edge that reaches
+            # the object, where something stands on the way in (a parcel dropped there): the last approach then
+            # drives in from there
+            steps = np.linspace(STANCE_BACKOFF, 0.0, 5)
+            options = [
+                _moved(stance, -step, aside)
+                for stance in stances
+                for step, aside in [(step, 0.0) for step in steps] + list(itertools.product(steps, STANCE_ASIDE))
+            ]
             navigator = self.context.navigator
             if navigator is not None:
-                room = navigator.grid.clearance_at(np.array(options))
-                fits = [xy for xy, free in zip(options, room, strict=True) if free >= navigator.clearance.minimum]
+                room = navigator.grid.clearance_at(np.array(options)[:, :2])
+                fits = [pose for pose, free in zip(options, room, strict=True) if free >= navigator.clearance.minimum]
                 options = fits or options
-            return np.array([*options[0], yaw])
+            return options[0]
         return self._facing(obj.position, OBJECT_STANDOFF)
+
+
+def _moved(pose: tuple[float, float, float], ahead: float, left: float) -> np.ndarray:
+    """``pose`` (x, y, yaw) moved ``ahead`` m along its heading and ``left`` m to its left, facing the same way."""
+    x, y, yaw = pose
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([x + ahead * c - left * s, y + ahead * s + left * c, yaw])
 
 
 class TurnParams(StrictModel):
