@@ -3,6 +3,7 @@
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from bt_humanoid.evaluation.episode import run_episode, watch_people
@@ -10,6 +11,7 @@ from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
 from bt_humanoid.sim.scene_config import load_scene
 from bt_humanoid.sim.world_config import load_world_config
+from bt_humanoid.skills.arm_skills import PULL, taking_force
 from bt_humanoid.testing.scenario import Scenario, build_run
 from bt_humanoid.testing.told import told_planning_context
 
@@ -121,3 +123,17 @@ def test_the_person_takes_a_mug_held_out_with_its_handle_to_their_side(seed: int
     assert record["command"] == "bring me the coffee mug"
     assert record["success"], record["failure"]
     assert record["person_contacts"] == 0 and not record["object_on_floor"]
+
+
+def test_only_a_pull_towards_the_person_and_the_weight_they_take_count_as_taking():
+    """The rule ``give`` lets go by, on made-up wrist forces (world frame): the person stands 1 m along +x."""
+    hand, person = np.array([0.0, 0.0]), np.array([1.0, 0.0])
+    towards = np.array([1.0, 0.0, 0.0])
+    assert taking_force(-6.0 * towards, hand, person) == pytest.approx(6.0)  # the wrist holds it back: a pull
+    assert taking_force(6.0 * towards, hand, person) == 0.0  # fingers closing round it push it at the robot
+    assert taking_force(np.array([0.0, 6.0, 0.0]), hand, person) == 0.0  # sideways: someone brushing past
+    assert taking_force(np.array([0.0, 0.0, -4.0]), hand, person) == pytest.approx(4.0)  # they hold it up
+    assert taking_force(np.array([0.0, 0.0, 4.0]), hand, person) == 0.0  # pressed down on: not taken
+    assert taking_force(np.array([-3.0, 0.0, -4.0]), hand, person) == pytest.approx(5.0)  # both at once
+    assert taking_force(-6.0 * towards, hand, np.array([-1.0, 0.0])) == 0.0  # the same force, them behind
+    assert PULL < 5.0, "a 5 N pull and lift lets go"

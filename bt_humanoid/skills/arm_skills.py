@@ -86,6 +86,18 @@ class Reach(_ManipulationSkill):
         return self.context.robot.whole_body.reach(p.side, target, gaze=position, move_base=p.move_base)
 
 
+def taking_force(change: np.ndarray, hand_xy: np.ndarray, person_xy: np.ndarray) -> float:
+    """N of a change in the wrist's force (world frame, x y z) that is a person at ``person_xy`` taking what the
+    hand at ``hand_xy`` holds: the wrist holding it back against their pull towards themselves, and the weight
+    they take off it. A push away from them, or sideways, is not taking (their fingers closing round a mug push
+    it back at the robot)."""
+    towards = np.asarray(person_xy, dtype=float) - np.asarray(hand_xy, dtype=float)
+    towards /= max(float(np.linalg.norm(towards)), 1e-9)
+    held_back = max(-float(change[:2] @ towards), 0.0)  # the wrist pulls away from them: they pull
+    lifted = max(-float(change[2]), 0.0)  # the wrist holds up less: they hold up the rest
+    return math.hypot(held_back, lifted)
+
+
 class GiveParams(StrictModel):
     to: str = Field("person", description="a person of the world (name or alias)")
     side: Side = Field("right", description="the hand holding the object")
@@ -180,15 +192,9 @@ class Give(_ManipulationSkill):
             self.motion.feedback = f"holding it out for {waited:.0f} s"
 
     def _taking(self, change: np.ndarray) -> float:
-        """N of a change in the wrist's force (world frame) that is the person taking the thing: the wrist
-        holding it back against their pull towards themselves, and the weight they take off it. A push away
-        from them, or sideways, is not taking."""
+        """N of a change in the wrist's force that is the person taking the thing (``taking_force``)."""
         hand = self.context.robot.whole_body.frame_pose(self.context.robot.whole_body.hand_frame(self.params.side))
-        towards = self.context.world_model.person(self.params.to)[:2] - hand.translation[:2]
-        towards /= max(float(np.linalg.norm(towards)), 1e-9)
-        held_back = max(-float(change[:2] @ towards), 0.0)  # the wrist pulls away from them: they pull
-        lifted = max(-float(change[2]), 0.0)  # the wrist holds up less: they hold up the rest
-        return math.hypot(held_back, lifted)
+        return taking_force(change, hand.translation[:2], self.context.world_model.person(self.params.to)[:2])
 
     def _let_go(self) -> MotionHandle:
         self.held.held_by = None
