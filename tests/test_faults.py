@@ -18,7 +18,8 @@ from bt_humanoid.evaluation.faults import FaultConfig, pick
 from bt_humanoid.evaluation.suite import load_suite
 
 SUITE = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "faults.yaml")
-KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command", "arm_bump"]
+KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command", "arm_bump", "off_centre"]
+OFF_CENTRE_BOTTLE = str(Path(__file__).resolve().parent / "data" / "off_centre_bottle.yaml")
 
 
 def _episode(kind: str) -> tuple[dict, list[dict]]:
@@ -101,6 +102,20 @@ def test_a_knock_on_the_carrying_arm_keeps_the_thing_in_hand():
     assert "8 N·s" in record["fault_fired"] and "carrying the red cube" in record["fault_fired"]
     assert record["success"], record["failure"]
     assert not record["object_on_floor"] and not record["collision"]
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+@pytest.mark.parametrize("suite, obj", [(SUITE, "red cube"), (OFF_CENTRE_BOTTLE, "water bottle")])
+def test_a_grasp_that_closes_off_the_object_s_centre_still_holds_it(suite: str, obj: str):
+    """Nudged 4 cm as the hand comes to it: the parallel fingers close on it where it is, 4 cm from where the
+    robot believes it, push it between them, and the robot brings it."""
+    events: list[dict] = []
+    record = run_episode(suite, KINDS.index("off_centre") if suite == SUITE else 0, events=events)
+    assert record["fault"] == "off_centre"
+    assert record["fault_fired"] and f"the {obj} was nudged 4.0 cm" in record["fault_fired"]
+    assert record["success"], record["failure"]
+    assert not record["object_on_floor"] and record["person_contacts"] == 0 and not record["ended_moving"]
 
 
 def test_a_fault_s_strength_may_be_a_span_drawn_per_episode():

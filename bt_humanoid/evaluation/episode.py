@@ -341,6 +341,8 @@ def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:
         return fault_kinds.Push(run, settings, draw.side_sign, draw.fault_rng)
     if kind == "arm_bump":
         return fault_kinds.ArmBump(run, draw.obj, settings, draw.side_sign, draw.fault_rng)
+    if kind == "off_centre":
+        return fault_kinds.OffCentre(run, draw.obj, settings, draw.fault_rng)
     if kind == "blind":
         return fault_kinds.Blind(run, settings, draw.fault_rng)
     if kind == "new_command":

@@ -10,6 +10,8 @@ control step and fires once, when its moment comes. A strength may be a span,
 - ``obstacle_dropped``: a box lands on the floor in front of the robot while it drives;
 - ``push``: someone shoves the robot sideways while it drives;
 - ``arm_bump``: someone walking past knocks the arm that carries something, while the robot drives;
+- ``off_centre``: the object is nudged a few centimetres just before the open fingers reach it, so the hand
+  closes off its centre (what a perception error of as much, or a knock to the table, does);
 - ``blind``: the head camera delivers no frames (colour and depth) for some seconds;
 - ``new_command``: a new command arrives mid-mission; the robot stops and does that instead.
 
@@ -54,7 +56,8 @@ def _span_within(most: float) -> Any:
     return Annotated[Span, AfterValidator(check)]
 
 
-SpanUpTo60, SpanUpTo100, SpanUpTo1000 = _span_within(60.0), _span_within(100.0), _span_within(1000.0)
+SpanUpTo005, SpanUpTo60 = _span_within(0.05), _span_within(60.0)
+SpanUpTo100, SpanUpTo1000 = _span_within(100.0), _span_within(1000.0)
 
 
 def pick(span: Span, rng: np.random.Generator) -> float:
@@ -88,6 +91,11 @@ class ArmBumpSettings(StrictModel):
     seconds: float = Field(0.15, gt=0, le=1, description="how long the knock lasts (force = impulse / seconds)")
 
 
+class OffCentreSettings(StrictModel):
+    offset: SpanUpTo005 = Field(0.03, description="m it is nudged, across the floor: a number, or [low, high]")
+    near: float = Field(0.12, gt=0, le=0.3, description="m between the grip point and the object when it is nudged")
+
+
 class BlindSettings(StrictModel):
     seconds: SpanUpTo60 = Field(4.0, description="how long the camera delivers no frames: a number, or [low, high]")
     after: float = Field(1.0, ge=0, le=600, description="s into the mission when it starts")
@@ -105,6 +113,7 @@ FAULT_MODELS: dict[str, type[StrictModel]] = {
     "obstacle_dropped": ObstacleDroppedSettings,
     "push": PushSettings,
     "arm_bump": ArmBumpSettings,
+    "off_centre": OffCentreSettings,
     "blind": BlindSettings,
     "new_command": NewCommandSettings,
 }
@@ -118,6 +127,7 @@ class FaultConfig(StrictModel):
     obstacle_dropped: ObstacleDroppedSettings | None = None
     push: PushSettings | None = None
     arm_bump: ArmBumpSettings | None = None
+    off_centre: OffCentreSettings | None = None
     blind: BlindSettings | None = None
     new_command: NewCommandSettings | None = None
 
@@ -336,6 +346,43 @@ class ArmBump(_Shove):
         model = self.run.sim.model
         hand = int(model.site_bodyid[model.site(self.run.context.robot_config.grippers[side].grip_site).id])
         self.shove(hand, f"the {side} hand carrying the {self.obj} was knocked")
+
+
+class OffCentre(Injector):
+    """Nudges the object ``offset`` across the floor, in a direction drawn per episode, as a hand comes within
+    ``near`` of it: the fingers then close off its centre, on a chord of a bottle or beside a box's middle.
+    Fires only where the object, moved, touches nothing it did not touch before (no pad inside it)."""
+
+    kind = "off_centre"
+
+    def __init__(self, run: MissionRun, obj: str, settings: OffCentreSettings, rng: np.random.Generator) -> None:
+        super().__init__(run)
+        self.obj, self.settings = obj, settings
+        angle = rng.uniform(0.0, 2.0 * math.pi)
+        self.shift = pick(settings.offset, rng) * np.array([math.cos(angle), math.sin(angle)])
+        self.body = run.sim.model.body(run.sim.object_bodies[obj]).id
+
+    def watch(self) -> None:
+        truth, model, data = self.run.truth, self.run.sim.model, self.run.sim.data
+        if truth.in_hand(self.obj) is not None:
+            return
+        centre = truth.object_centre(self.obj)
+        for side, gripper in self.run.context.robot_config.grippers.items():
+            grip = data.site_xpos[model.site(gripper.grip_site).id]
+            if np.linalg.norm(grip - centre) <= self.settings.near and self._nudge(self.shift):
+                offset = float(np.linalg.norm(self.shift)) * 100
+                self.fire(f"the {self.obj} was nudged {offset:.1f} cm as the {side} hand came to it")
+                return
+
+    def _nudge(self, shift: np.ndarray) -> bool:
+        """Move the object by ``shift`` (x, y); undo it, and say False, where it then touches something new."""
+        before = self.run.truth.geoms_in_contact(self.body)
+        position = self.run.truth.object_position(self.obj)
+        move_free_body(self.run, self.run.sim.object_bodies[self.obj], position + np.array([*shift, 0.0]))
+        if self.run.truth.geoms_in_contact(self.body) <= before:
+            return True
+        move_free_body(self.run, self.run.sim.object_bodies[self.obj], position)
+        return False
 
 
 class Blind(Injector):

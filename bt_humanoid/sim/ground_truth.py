@@ -115,11 +115,15 @@ class GroundTruth:
     def in_hand(self, obj: str) -> str | None:
         """The side whose two finger pads both touch the object, else None."""
         touching = self.geoms_in_contact(self._object_body(obj))
-        names = {self.model.geom(g).name for g in touching}
-        for side, prefix in (("left", "l"), ("right", "r")):
-            if {f"{prefix}_pad_a", f"{prefix}_pad_b"} <= names:
+        for side in ("left", "right"):
+            if set(self.pad_geoms(side)) <= touching:
                 return side
         return None
+
+    def pad_geoms(self, side: str) -> tuple[int, int]:
+        """The geoms of a hand's two finger pads (``l_pad_a``, ``l_pad_b``; ``r_`` on the right)."""
+        prefix = side[0]
+        return self.model.geom(f"{prefix}_pad_a").id, self.model.geom(f"{prefix}_pad_b").id
 
     def gripper_width(self, side: str) -> float:
         joints = self.sim.robot.grippers[side].joints
