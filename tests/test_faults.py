@@ -18,7 +18,17 @@ from bt_humanoid.evaluation.faults import FaultConfig, pick
 from bt_humanoid.evaluation.suite import load_suite
 
 SUITE = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "faults.yaml")
-KINDS = ["slip", "target_moved", "obstacle_dropped", "push", "blind", "new_command", "arm_bump", "off_centre"]
+KINDS = [
+    "slip",
+    "target_moved",
+    "obstacle_dropped",
+    "push",
+    "blind",
+    "new_command",
+    "arm_bump",
+    "off_centre",
+    "way_closed",
+]
 OFF_CENTRE_BOTTLE = str(Path(__file__).resolve().parent / "data" / "off_centre_bottle.yaml")
 
 
@@ -116,6 +126,18 @@ def test_a_grasp_that_closes_off_the_object_s_centre_still_holds_it(suite: str, 
     assert record["fault_fired"] and f"the {obj} was nudged 4.0 cm" in record["fault_fired"]
     assert record["success"], record["failure"]
     assert not record["object_on_floor"] and record["person_contacts"] == 0 and not record["ended_moving"]
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+def test_a_box_that_closes_the_gap_on_the_way_is_driven_round_the_long_way():
+    """The box lands between the storage box and the table, 1 m ahead: the way round is 1.5 m longer."""
+    record, _ = _episode("way_closed")
+    assert "a box closed the way" in record["fault_fired"]
+    longer = float(record["fault_fired"].split("the way round is ")[1].split(" m")[0])
+    assert longer >= 1.0
+    assert record["success"], record["failure"]
+    assert not record["collision"], "it did not squeeze past: there was no room"
 
 
 def test_a_fault_s_strength_may_be_a_span_drawn_per_episode():

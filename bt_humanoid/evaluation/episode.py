@@ -337,6 +337,8 @@ def _arm(fault, run: MissionRun, draw: Draw) -> fault_kinds.Injector:
         return fault_kinds.TargetMoved(run, draw.obj, settings, draw.spare_spots)
     if kind == "obstacle_dropped":
         return fault_kinds.ObstacleDropped(run, settings)
+    if kind == "way_closed":
+        return fault_kinds.WayClosed(run, settings)
     if kind == "push":
         return fault_kinds.Push(run, settings, draw.side_sign, draw.fault_rng)
     if kind == "arm_bump":

@@ -8,6 +8,7 @@ control step and fires once, when its moment comes. A strength may be a span,
 - ``slip``: the object's surface turns slippery just after it is lifted, so it slides out of the fingers;
 - ``target_moved``: someone moves the object to another spot while the robot drives towards it;
 - ``obstacle_dropped``: a box lands on the floor in front of the robot while it drives;
+- ``way_closed``: a box lands in the narrowest gap on the robot's way ahead, closing it: the way round is longer;
 - ``push``: someone shoves the robot sideways while it drives;
 - ``arm_bump``: someone walking past knocks the arm that carries something, while the robot drives;
 - ``off_centre``: the object is nudged a few centimetres just before the open fingers reach it, so the hand
@@ -31,6 +32,8 @@ import mujoco
 import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
+from bt_humanoid.navigation.navigator import OBSERVED_PADDING
+from bt_humanoid.navigation.planner import PlanError, plan_route
 from bt_humanoid.strict_model import StrictModel, exactly_one
 
 if TYPE_CHECKING:
@@ -38,6 +41,8 @@ if TYPE_CHECKING:
 
 PLACE_CLEARANCE = 1.0  # m a dropped box keeps from goals, named places and people
 DRIVING = 0.15  # m/s of base speed above which the robot counts as driving
+LOOK_PERIOD = 0.5  # s between way_closed's looks for a gap on the route
+CANDIDATES = 3  # narrowest points of the route ahead way_closed tries per look (a route planned for each)
 SPARE_BOX = "parcel"  # the free box in a corner of the apartment that obstacle_dropped drops on the robot's way
 
 
@@ -80,6 +85,12 @@ class ObstacleDroppedSettings(StrictModel):
     ahead: float = Field(1.4, gt=0.6, le=4, description="m ahead of the base where the box lands")
 
 
+class WayClosedSettings(StrictModel):
+    nearest: float = Field(1.0, gt=0.6, le=4, description="m along the route ahead where the gap may be, from ...")
+    farthest: float = Field(4.0, gt=0.6, le=10, description="... to")
+    detour: float = Field(1.0, gt=0, le=20, description="m the way round is longer, at least")
+
+
 class PushSettings(StrictModel):
     # a person's shove on a standing adult is 40-80 N·s (issue 26); MuJoCo's xfrc_applied acts on the base link
     impulse: SpanUpTo1000 = Field(60.0, description="N·s sideways on the base: a number, or [low, high]")
@@ -111,6 +122,7 @@ FAULT_MODELS: dict[str, type[StrictModel]] = {
     "slip": SlipSettings,
     "target_moved": TargetMovedSettings,
     "obstacle_dropped": ObstacleDroppedSettings,
+    "way_closed": WayClosedSettings,
     "push": PushSettings,
     "arm_bump": ArmBumpSettings,
     "off_centre": OffCentreSettings,
@@ -125,6 +137,7 @@ class FaultConfig(StrictModel):
     slip: SlipSettings | None = None
     target_moved: TargetMovedSettings | None = None
     obstacle_dropped: ObstacleDroppedSettings | None = None
+    way_closed: WayClosedSettings | None = None
     push: PushSettings | None = None
     arm_bump: ArmBumpSettings | None = None
     off_centre: OffCentreSettings | None = None
@@ -286,12 +299,73 @@ class ObstacleDropped(Injector):
         footprint = run.context.robot_config.base.footprint_radius
         if run.navigator.grid.clearance_at(spot[None, :])[0] < self.half + 2 * footprint:
             return False
-        keep_clear = [np.array(p.pose[:2]) for p in run.context.world.places.values()]
+        places = [np.array(p.pose[:2]) for p in run.context.world.places.values()]
+        return self._clear_of(spot, places)
+
+    def _clear_of(self, spot: np.ndarray, places: list[np.ndarray]) -> bool:
+        """``PLACE_CLEARANCE`` from ``places``, the robot's goal and the people."""
+        run = self.run
+        keep_clear = list(places)
         keep_clear += [run.truth.person_position(name)[:2] for name in run.context.world.people]
         keep_clear += [run.truth.person_position(name)[:2] for name in run.context.world.walkers]
         if run.navigator.goal is not None:
             keep_clear.append(np.asarray(run.navigator.goal[:2]))
         return all(np.hypot(*(spot - other)) >= PLACE_CLEARANCE for other in keep_clear)
+
+
+class WayClosed(ObstacleDropped):
+    """The free box lands in a gap on the robot's route ahead that it closes: the robot cannot pass beside it,
+    and the way round is at least ``detour`` longer (a box in a passage, not on open floor). Looked for twice a
+    second while the robot drives, at the narrowest points of the route first; only where the map, with the box
+    on it, still has a way round, and not within ``PLACE_CLEARANCE`` of the goal or a person."""
+
+    kind = "way_closed"
+
+    def __init__(self, run: MissionRun, settings: WayClosedSettings) -> None:
+        super().__init__(run, ObstacleDroppedSettings())
+        self.settings = settings
+        self.floor_plan = run.navigator.grid.without_observed()  # furniture only: gaps are between furniture
+        self.next_look = 0.0
+
+    def watch(self) -> None:
+        navigator, now = self.run.navigator, self.run.sim.time
+        if now < self.next_look or not self.driving() or navigator.route is None or navigator.goal is None:
+            return
+        self.next_look = now + LOOK_PERIOD
+        route, s = navigator.route, navigator.follower.progress
+        ahead = np.flatnonzero(
+            (route.arc_length >= s + self.settings.nearest) & (route.arc_length <= s + self.settings.farthest)
+        )
+        room = self.floor_plan.clearance_at(route.points[ahead])
+        footprint = self.run.context.robot_config.base.footprint_radius
+        # the box fits there (its corners clear the furniture) and leaves the robot no way past: it keeps its
+        # footprint and the padding for what it sees (things that may move) from the box
+        fits = (room >= self.half * math.sqrt(2) + 0.02) & (room < self.half + footprint + OBSERVED_PADDING)
+        for index in ahead[fits][np.argsort(room[fits])][:CANDIDATES]:
+            spot = route.points[index]
+            if not self._clear_of(spot, []):
+                continue
+            longer = self._way_round(spot) - (route.length - s)
+            if longer >= self.settings.detour:
+                move_free_body(self.run, SPARE_BOX, np.array([*spot, self.height + 0.01]))
+                self.fire(
+                    f"a box closed the way {route.arc_length[index] - s:.1f} m ahead, at ({spot[0]:.2f}, "
+                    f"{spot[1]:.2f}): the way round is {longer:.1f} m longer"
+                )
+                return
+
+    def _way_round(self, spot: np.ndarray) -> float:
+        """m of the shortest route to the goal on the floor plan with the box at ``spot`` (as the robot would see
+        it); 0 where there is none."""
+        navigator = self.run.navigator
+        closed = self.floor_plan.without_observed()
+        closed.seen_at = closed.seen_at.copy()  # a copy's marks stay its own
+        side = np.arange(-self.half, self.half + 1e-9, closed.resolution / 2)
+        closed.mark(spot + np.stack(np.meshgrid(side, side), axis=-1).reshape(-1, 2))
+        try:
+            return plan_route(closed, navigator.robot.base.pose(), navigator.goal, navigator.clearance).length
+        except PlanError:
+            return 0.0
 
 
 class _Shove(Injector):
