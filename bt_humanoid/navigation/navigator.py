@@ -4,7 +4,10 @@
 Every control step the navigator updates the map from the head depth camera
 (at the camera's rate) and checks the route ahead against it: when something
 now blocks it, the robot replans from where it is and carries on, or stops
-with the reason if no route is left. Skills talk to the navigator through
+with the reason if no route is left. Where something the camera saw stands on
+the goal itself (a parcel on a stance, a person nearer than the stance by them
+allows), a skill that passed ``choose_goal`` is asked for the goal afresh, on
+the map as it is now. Skills talk to the navigator through
 the motion handles it returns; recovery (clear the map, spin, back up, wait)
 is tree structure in behaviors/navigate.yaml.
 """
