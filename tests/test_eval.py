@@ -32,7 +32,7 @@ def test_wilson_interval_matches_published_values():
     assert low < 0.95 < high and high - low < 0.07
 
 
-@pytest.mark.parametrize("name", ["fetch", "faults", "smoke"])
+@pytest.mark.parametrize("name", ["fetch", "fetch_faults", "faults", "smoke"])
 def test_every_suite_in_the_repository_is_valid(name):
     suite, world = load_suite(BENCHMARKS / f"{name}.yaml")
     assert suite.episodes >= 1 and world.name == suite.world
