@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from bt_humanoid.benchmarks.common import benchmark_parser, parse_benchmark_args, save_figures
-from bt_humanoid.control.stance import stance_for
+from bt_humanoid.control.stance import stances_for
 from bt_humanoid.engine.runner import MissionRun
 from bt_humanoid.perception.world_model import SupportSurface
 from bt_humanoid.sim.robot_config import RobotConfig, load_robot_config
@@ -104,7 +104,7 @@ def sample_trial(kitchen: Kitchen, name: str, task: str, surface: str, rng: np.r
     centre = region.region.mean(axis=0)
     for _ in range(ATTEMPTS):
         heading = rng.uniform(-math.pi, math.pi)
-        x, y, yaw = stance_for(spot, region, SIDE, kitchen.footprint, kitchen.bounds, centre + 3.0 * _unit(heading))
+        x, y, yaw = stances_for(spot, region, SIDE, kitchen.footprint, kitchen.bounds, centre + 3.0 * _unit(heading))[0]
         start = np.array([x, y]) - START_BACK * _unit(yaw)
         if kitchen.grid.clearance_at(start[None, :])[0] >= kitchen.footprint + STANCE_ROOM:
             break

@@ -23,45 +23,6 @@ class StanceError(ValueError):
     """No stance reaches the spot."""
 
 
-def stance_for(
-    spot: np.ndarray,
-    surface: SupportSurface,
-    side: str,
-    footprint_radius: float,
-    bounds: np.ndarray,
-    robot_xy: np.ndarray,
-    standoff: float | None = None,
-    max_depth: float = MAX_DEPTH,
-    hand_lateral: float = HAND_LATERAL,
-    closest: float | None = None,
-    nearer: float = 0.0,
-    aside: float = 0.0,
-) -> tuple[float, float, float]:
-    """Base pose (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``: ``standoff`` m from
-    the edge (default: the footprint ``EDGE_CLEARANCE`` clear of it), the spot at most ``max_depth`` behind it
-    and ``hand_lateral`` to the working hand's side. With ``closest``, a deeper spot brings the stance nearer
-    the edge by as much, down to ``closest`` m from it: the hand then reaches as far ahead of the base; and
-    ``nearer`` m more, still not past ``closest``, and ``aside`` m to its left along the edge (a hand that fell
-    short from there: ahead, and to a side).
-
-    Of the edges that reach the spot, the one whose stance is nearest the robot wins.
-    """
-    return stances_for(
-        spot,
-        surface,
-        side,
-        footprint_radius,
-        bounds,
-        robot_xy,
-        standoff,
-        max_depth,
-        hand_lateral,
-        closest,
-        nearer,
-        aside,
-    )[0]
-
-
 def stances_for(
     spot: np.ndarray,
     surface: SupportSurface,
@@ -76,8 +37,13 @@ def stances_for(
     nearer: float = 0.0,
     aside: float = 0.0,
 ) -> list[tuple[float, float, float]]:
-    """Every stance of ``stance_for``, one per edge that reaches the spot, nearest the robot first: the next
-    ones are where to work from when something stands on the first."""
+    """Base poses (x, y, yaw rad) from which ``side``'s hand reaches ``spot`` on ``surface``, one per edge that
+    reaches it, nearest the robot first (the next ones are where to work from when something stands on the
+    first): ``standoff`` m from the edge (default: the footprint ``EDGE_CLEARANCE`` clear of it), the spot at
+    most ``max_depth`` behind it and ``hand_lateral`` to the working hand's side. With ``closest``, a deeper
+    spot brings the stance nearer the edge by as much, down to ``closest`` m from it: the hand then reaches as
+    far ahead of the base; and ``nearer`` m more, still not past ``closest``, and ``aside`` m to its left along
+    the edge (a hand that fell short from there: ahead, and to a side)."""
     (x0, y0), (x1, y1) = surface.region
     x, y = float(spot[0]), float(spot[1])
     standoff = footprint_radius + EDGE_CLEARANCE if standoff is None else standoff
@@ -118,8 +84,8 @@ def working_stance(
     robot_xy: np.ndarray,
     shift: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[float, float, float]:
-    """``stance_for`` where the robot's own ``base.working_stance`` says (robot.yaml), moved by ``shift`` (m
-    ahead, nearer the edge where its ``closest`` allows; m to the left)."""
+    """The nearest stance of ``stances_for`` where the robot's own ``base.working_stance`` says (robot.yaml),
+    moved by ``shift`` (m ahead, nearer the edge where its ``closest`` allows; m to the left)."""
     return working_stances(spot, surface, side, base, bounds, robot_xy, shift)[0]
 
 

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from bt_humanoid.control.stance import MAX_DEPTH, StanceError, stance_for
+from bt_humanoid.control.stance import MAX_DEPTH, StanceError, stances_for
 from bt_humanoid.perception.world_model import SupportSurface
 
 EDGE_MARGIN = 0.2  # m between a spot and any edge it is not reached across (the base clears the corners)
@@ -52,7 +52,7 @@ def reachable_spot(
             if depth > max_depth - REACH_SLACK:
                 continue
             try:
-                x, y, yaw = stance_for(spot, surface, "right", footprint, bounds, centre + 3.0 * direction)
+                x, y, yaw = stances_for(spot, surface, "right", footprint, bounds, centre + 3.0 * direction)[0]
             except StanceError:
                 continue
             facing = -np.array([math.cos(yaw), math.sin(yaw)])
