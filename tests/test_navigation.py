@@ -422,3 +422,20 @@ def test_a_goal_chosen_again_is_kept_when_the_answer_has_no_more_room_and_the_ro
     finally:
         navigator.halt()
         run.stack.close()
+
+
+def test_a_free_pose_near_a_taken_goal_is_the_nearest_with_room_facing_the_same_way():
+    """What a search looks from when something stands on the place it looks from (seed 2's episode 67: the
+    table's viewpoint held by what the camera saw, after a push)."""
+    run = build_run({"mission": "to the kitchen", "tree": {"wait": {"seconds": 0}}})
+    navigator = run.navigator
+    try:
+        goal = _kitchen_taken(run)
+        assert navigator.free_pose_near(goal, 0.0)[:2] == pytest.approx(goal[:2]), "nothing near: the goal"
+        near = navigator.free_pose_near(goal, 1.0)
+        assert near[2] == goal[2] and 0.0 < math.dist(near[:2], goal[:2]) <= 1.0
+        assert navigator.grid.clearance_at(near[None, :2])[0] >= navigator.clearance.minimum
+        navigator.grid.clear_observed()
+        assert navigator.free_pose_near(goal, 1.0) == pytest.approx(goal), "a goal with room is kept"
+    finally:
+        run.stack.close()

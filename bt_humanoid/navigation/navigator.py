@@ -158,6 +158,18 @@ class Navigator:
         free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
         return points[free[0]] if free.size else None
 
+    def free_pose_near(self, goal: np.ndarray, within: float) -> np.ndarray:
+        """The pose nearest ``goal`` (x, y, yaw), within ``within`` m and facing the same way, whose footprint has
+        room on the map as it is now: ``goal`` itself if it has, or if none has."""
+        rings = np.arange(0.0, within + 1e-9, self.grid.resolution * 2)
+        angles = np.linspace(0.0, 2 * math.pi, 12, endpoint=False)
+        offsets = np.concatenate(
+            [[[0.0, 0.0]], *(r * np.column_stack([np.cos(angles), np.sin(angles)]) for r in rings[1:])]
+        )
+        points = np.asarray(goal, dtype=float)[:2] + offsets
+        free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
+        return np.array([*points[free[0]], goal[2]]) if free.size else np.asarray(goal, dtype=float)
+
     def is_furniture(self, points: np.ndarray) -> np.ndarray:
         """Per floor point (x, y): on or next to the map's furniture and walls (outside the map counts too)."""
         rows, cols = self.grid.cell(points)

@@ -29,6 +29,7 @@ from bt_humanoid.strict_model import StrictModel
 
 LOOK_AROUND = (0.0, 1.0, -1.0)  # head pan (rad) of each look when the object is not known yet
 SEARCH_SPEED = 0.6  # m/s between places while searching
+VIEW_NEAR = 1.0  # m from a place where a search may look from instead, when something stands on the place
 STEP_BACK = 0.35  # m back from a surface before folding the arms to search
 
 
@@ -84,7 +85,9 @@ class Find(_ManipulationSkill):
             return None
         x, y, yaw = place.pose
         goal = np.array([x, y, math.radians(yaw)])
-        handle = self.context.navigator.go_to(goal, SEARCH_SPEED)
+        navigator = self.context.navigator
+        # any spot near the place looks at it as well: one someone stands on (or a box was dropped on) is moved
+        handle = navigator.go_to(goal, SEARCH_SPEED, choose_goal=lambda: navigator.free_pose_near(goal, VIEW_NEAR))
         return None if handle.done else handle  # a place it cannot reach is skipped
 
     def _recall(self) -> None:
