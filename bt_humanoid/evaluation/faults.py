@@ -359,7 +359,6 @@ class WayClosed(ObstacleDropped):
         it); 0 where there is none."""
         navigator = self.run.navigator
         closed = self.floor_plan.without_observed()
-        closed.seen_at = closed.seen_at.copy()  # a copy's marks stay its own
         side = np.arange(-self.half, self.half + 1e-9, closed.resolution / 2)
         closed.mark(spot + np.stack(np.meshgrid(side, side), axis=-1).reshape(-1, 2))
         try:

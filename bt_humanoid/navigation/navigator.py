@@ -155,7 +155,7 @@ class Navigator:
         back = -np.array([math.cos(yaw), math.sin(yaw)])
         steps = np.arange(0.0, longest + 1e-9, self.grid.resolution)
         points = np.asarray(xy, dtype=float)[:2] + steps[:, None] * back
-        free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
+        free = np.flatnonzero(self.has_room(points))
         return points[free[0]] if free.size else None
 
     def free_pose_near(self, goal: np.ndarray, within: float) -> np.ndarray:
@@ -167,8 +167,13 @@ class Navigator:
             [[[0.0, 0.0]], *(r * np.column_stack([np.cos(angles), np.sin(angles)]) for r in rings[1:])]
         )
         points = np.asarray(goal, dtype=float)[:2] + offsets
-        free = np.flatnonzero(self.grid.clearance_at(points) >= self.clearance.minimum)
+        free = np.flatnonzero(self.has_room(points))
         return np.array([*points[free[0]], goal[2]]) if free.size else np.asarray(goal, dtype=float)
+
+    def has_room(self, points: np.ndarray) -> np.ndarray:
+        """Per floor point (x, y): whether the footprint standing there clears everything on the map as it is
+        now (where a route may start or end)."""
+        return self.grid.clearance_at(np.asarray(points, dtype=float)[:, :2]) >= self.clearance.minimum
 
     def is_furniture(self, points: np.ndarray) -> np.ndarray:
         """Per floor point (x, y): on or next to the map's furniture and walls (outside the map counts too)."""
@@ -261,13 +266,12 @@ class Navigator:
         room and the answer has enough; False (keep it: wait for the way to clear) otherwise."""
         if self.choose_goal is None or self.goal is None or self.goals_chosen >= GOAL_RECHOICES:
             return False
-        minimum = self.clearance.minimum
-        if self.grid.clearance_at(self.goal[None, :2])[0] >= minimum:
+        if self.has_room(self.goal[None])[0]:
             return False  # the goal has room: the way to it is what is blocked
-        if self.grid.without_observed().clearance_at(self.goal[None, :2])[0] < minimum:
+        if self.grid.without_observed().clearance_at(self.goal[None, :2])[0] < self.clearance.minimum:
             return False  # furniture, not something seen: choosing again would not help
         goal = np.asarray(self.choose_goal(), dtype=float)
-        if np.allclose(goal[:2], self.goal[:2], atol=1e-3) or self.grid.clearance_at(goal[None, :2])[0] < minimum:
+        if np.allclose(goal[:2], self.goal[:2], atol=1e-3) or not self.has_room(goal[None])[0]:
             return False
         self.goal = goal
         self.goals_chosen += 1

@@ -87,6 +87,7 @@ class OccupancyGrid:
         """A copy with only the static map: what the floor would be if everything the camera saw moved away."""
         grid = copy.copy(self)
         grid.observed = np.zeros_like(self.observed)
+        grid.seen_at = np.full(self.shape, -np.inf)  # its own: what is marked on the copy stays on the copy
         grid._clearance = None
         return grid
 

@@ -175,8 +175,7 @@ class NavigateTo(_BaseSkill):
         poses = np.column_stack([xy, np.arctan2(-np.sin(angles), -np.cos(angles))])
         navigator = self.context.navigator
         if navigator is not None:
-            room = navigator.grid.clearance_at(poses[:, :2])
-            free = np.flatnonzero(room >= navigator.clearance.minimum)
+            free = np.flatnonzero(navigator.has_room(poses))
             if free.size:
                 return poses[free[0]]
         return poses[0]
@@ -206,8 +205,8 @@ class NavigateTo(_BaseSkill):
             ]
             navigator = self.context.navigator
             if navigator is not None:
-                room = navigator.grid.clearance_at(np.array(options)[:, :2])
-                fits = [pose for pose, free in zip(options, room, strict=True) if free >= navigator.clearance.minimum]
+                room = navigator.has_room(np.array(options))
+                fits = [pose for pose, free in zip(options, room, strict=True) if free]
                 options = fits or options
             return options[0]
         return self._facing(obj.position, OBJECT_STANDOFF)
