@@ -44,8 +44,12 @@ def test_the_fetch_suite_meets_the_issue_s_shape():
     assert len(set(suite.objects)) >= 3
     assert suite.faults.share >= 0.2
     faults = {fault.kind: fault.settings for fault in suite.faults.kinds}
-    assert set(faults) == {"slip", "target_moved", "obstacle_dropped", "push", "arm_bump", "blind", "new_command"}
+    assert set(faults) == {
+        "slip", "target_moved", "obstacle_dropped", "push", "arm_bump", "blind", "new_command", "off_centre",
+        "way_closed",
+    }  # fmt: skip
     assert faults["push"].impulse == (40.0, 80.0)  # N·s: issue 26's shoves
+    assert faults["off_centre"].offset == (0.02, 0.04)  # m: a bottle grasped off its centre
     assert faults["blind"].seconds == (5.0, 10.0)
 
 

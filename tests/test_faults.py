@@ -30,6 +30,8 @@ KINDS = [
     "way_closed",
 ]
 OFF_CENTRE_BOTTLE = str(Path(__file__).resolve().parent / "data" / "off_centre_bottle.yaml")
+FETCH_FAULTS = str(Path(__file__).resolve().parents[1] / "missions" / "benchmarks" / "fetch_faults.yaml")
+FETCH_SEVEN_KINDS = str(Path(__file__).resolve().parent / "data" / "fetch_seven_kinds.yaml")
 
 
 def _episode(kind: str) -> tuple[dict, list[dict]]:
@@ -117,15 +119,33 @@ def test_a_knock_on_the_carrying_arm_keeps_the_thing_in_hand():
 @pytest.mark.slow
 @pytest.mark.sim
 @pytest.mark.parametrize("suite, obj", [(SUITE, "red cube"), (OFF_CENTRE_BOTTLE, "water bottle")])
-def test_a_grasp_that_closes_off_the_object_s_centre_still_holds_it(suite: str, obj: str):
+def test_a_grasp_that_closes_off_the_object_s_centre_is_felt_let_go_and_taken_again(suite: str, obj: str):
     """Nudged 4 cm as the hand comes to it: the parallel fingers close on it where it is, 4 cm from where the
-    robot believes it, push it between them, and the robot brings it."""
+    robot believes it. The cube, nudged mostly along the way the fingers close, is pushed between them and
+    brought. The bottle, nudged across the pads, is felt at their edge as the first pad touches it, before a
+    squeeze pushes it over: the hand lets go, and the next grasp takes it by its middle."""
     events: list[dict] = []
     record = run_episode(suite, KINDS.index("off_centre") if suite == SUITE else 0, events=events)
     assert record["fault"] == "off_centre"
     assert record["fault_fired"] and f"the {obj} was nudged 4.0 cm" in record["fault_fired"]
+    if obj == "water bottle":
+        assert any("at their edge" in failure for failure in _failures(events)), _failures(events)
     assert record["success"], record["failure"]
     assert not record["object_on_floor"] and record["person_contacts"] == 0 and not record["ended_moving"]
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+def test_a_cube_closed_on_by_the_pads_edge_is_felt_and_taken_again_before_it_is_handed_over():
+    """fetch_faults' episode 16: the cube nudged 3.6 cm across the pads, closed on by their last 7 mm. Held like
+    that, the person's fingers met the robot's pads and the cube fell to the floor; now the pads feel it at
+    their edge, the hand lets go, and the cube taken by its middle ends in the person's hand."""
+    events: list[dict] = []
+    record = run_episode(FETCH_FAULTS, 16, events=events)
+    assert record["fault"] == "off_centre" and "nudged 3.6 cm" in record["fault_fired"]
+    assert any("(felt by the pads): let go to grasp it afresh" in f for f in _failures(events)), _failures(events)
+    assert record["success"], record["failure"]
+    assert not record["object_on_floor"]
 
 
 @pytest.mark.slow
@@ -161,7 +181,7 @@ def test_the_suite_takes_fault_kinds_in_turn(kind):
 def test_a_bottle_that_slips_but_stays_caught_in_the_pads_is_set_down_and_grasped_afresh():
     # the fetch suite's episode 147: the wet bottle slides down between the pads and is caught at another width;
     # carried like that it once went round the flat, held, while the robot searched the rooms for it
-    fetch = str(Path(SUITE).with_name("fetch.yaml"))
+    fetch = FETCH_SEVEN_KINDS
     events: list[dict] = []
     record = run_episode(fetch, 147, events=events)
     assert record["fault"] == "slip" and record["fault_fired"]
@@ -177,7 +197,7 @@ def test_a_box_dropped_beside_the_base_out_of_the_camera_s_view_is_backed_away_f
     # the fetch suite's episode 39 at seed 1: the box landed where the head camera, looking along the route, never
     # saw it; the route passed it, a protective stop held the base 0.2 m from it for 10 s, and the search failed.
     # Now what the base scanner senses goes on the map after a second's hold, and the robot backs out and replans
-    fetch = str(Path(SUITE).with_name("fetch.yaml"))
+    fetch = FETCH_SEVEN_KINDS
     events: list[dict] = []
     record = run_episode(fetch, 39, seed=1, events=events)
     assert record["fault"] == "obstacle_dropped" and record["fault_fired"]

@@ -19,6 +19,7 @@ EMPTY_WIDTH = 0.004  # m: a gap below this after closing means nothing is held
 STALL_SPEED = 0.004  # m/s: fingers slower than this have stopped closing
 MIN_CLOSING_TIME = 0.15  # s before a stall counts (the fingers must get going first)
 GRASP_TIMEOUT = 3.0  # s
+MIN_PRESSURE = 0.5  # N on all the taxels of a hand together: less is not a grip
 
 
 class GripperController:
@@ -27,22 +28,40 @@ class GripperController:
     def __init__(self, joints: JointReferenceController, grippers: dict[str, GripperConfig]) -> None:
         self.joints = joints
         self.grippers = grippers
-        self._grasps: dict[str, tuple[MotionHandle, float]] = {}
+        self._grasps: dict[str, tuple[MotionHandle, float, float | None]] = {}
+        # per hand: its pads' taxels (touch sensors) and where each lies across the pads' width (m, the hand's y)
+        self._taxels = {
+            side: [(name, float(joints.io.sensor_offset(name)[1]))
+                   for pad in config.tactile_pads for name in joints.io.sensors_named(f"{pad}_taxel")]
+            for side, config in grippers.items()
+        }  # fmt: skip
 
-    def grasp(self, side: str) -> MotionHandle:
-        """Close until the fingers stall; succeeds holding something, fails having closed on nothing."""
+    def grasp(self, side: str, edge: float | None = None) -> MotionHandle:
+        """Close until the fingers stall; succeeds holding something, fails having closed on nothing.
+
+        ``edge`` (m): stop closing, and fail, as soon as the pads feel the thing press further than this from
+        their middle. A round thing touched by the pads' edges is squeezed out sideways, or over, by closing on.
+        """
         self.command(side, "close")
         handle = MotionHandle(f"closing the {side} gripper")
-        self._grasps[side] = (handle, self.joints.io.time)
+        self._grasps[side] = (handle, self.joints.io.time, edge)
         return handle
 
     def step(self) -> None:
-        """Judge grasps in progress: stalled on something, or shut on nothing."""
-        for side, (handle, started) in list(self._grasps.items()):
+        """Judge grasps in progress: stalled on something, or shut on nothing (or felt at the pads' edge)."""
+        for side, (handle, started, edge) in list(self._grasps.items()):
             if handle.done:
                 del self._grasps[side]
                 continue
             idx = self.joints.indices(self.grippers[side].joints)
+            felt = self.pressure_centre(side) if edge is not None else None
+            if felt is not None and abs(felt) > edge:
+                # hold the fingers where they are: no harder squeeze on it
+                where = self.joints.io.positions()[idx].tolist()
+                self.joints.move(dict(zip(self.grippers[side].joints, where, strict=True)))
+                handle.fail(f"the {side} pads touched it {abs(felt) * 100:.1f} cm off their middle, at their edge")
+                del self._grasps[side]
+                continue
             elapsed = self.joints.io.time - started
             stalled = np.all(np.abs(self.joints.io.velocities()[idx]) < STALL_SPEED)
             if elapsed < MIN_CLOSING_TIME or not (stalled or elapsed > GRASP_TIMEOUT):
@@ -88,6 +107,15 @@ class GripperController:
         idx = self.joints.indices(config.joints)
         commanded_closed = np.allclose(self.joints.position[idx], config.closed, atol=1e-4)
         return bool(commanded_closed and self.width(side) > EMPTY_WIDTH)
+
+    def pressure_centre(self, side: str) -> float | None:
+        """Where across the pads' width (m from their middle, along the hand's y axis) what they hold presses on
+        them, from the taxels' forces; None for pads that feel nothing (or have no taxels)."""
+        taxels = self._taxels[side]
+        forces = np.array([float(self.joints.io.sensor(name)[0]) for name, _ in taxels])
+        if not len(taxels) or forces.sum() < MIN_PRESSURE:
+            return None
+        return float(forces @ np.array([across for _, across in taxels]) / forces.sum())
 
     def shut(self, side: str) -> bool:
         """The pads are together: nothing is between them."""

@@ -68,6 +68,8 @@ ARM_GAINS = {
     "wrist_yaw": (40.0, 8.0),
 }
 FINGER_GAIN, FINGER_FORCE = 400.0, 15.0  # N/m and N: a firm but human grip
+# a finger pad on smooth glass, plastic or glazed ceramic: 0.78 measured on wet glass (docs/dependencies.md)
+SKIN_FRICTION = 0.8
 
 
 def arm_joint_names(person: str) -> list[str]:
@@ -113,7 +115,7 @@ def add_arm(spec: mujoco.MjSpec, person: str) -> None:
         finger.add_geom(
             name=f"{person}_finger_{side}", type=mujoco.mjtGeom.mjGEOM_BOX,
             size=[TIP_LENGTH / 2, TIP_DEPTH / 2, 0.015], pos=[TIP_AT, sign * (FINGER_OPEN + TIP_DEPTH / 2), 0],
-            mass=0.01, rgba=skin, friction=[1.0, 0.02, 0.001], condim=4, priority=1,
+            mass=0.01, rgba=skin, friction=[SKIN_FRICTION, 0.02, 0.001], condim=4, priority=1,
         )  # fmt: skip
         finger.add_geom(
             name=f"{person}_finger_{side}_bar", type=mujoco.mjtGeom.mjGEOM_BOX, size=[FINGER_LENGTH / 2, 0.003, 0.012],

@@ -123,6 +123,11 @@ class GripperConfig(StrictModel):
         description="joint ranges (rad) within which the fingers open fully without meeting the arm; "
         "the whole-body controller keeps to them while the hand is open",
     )
+    tactile_pads: list[str] = Field(
+        default_factory=list,
+        description="finger pads that feel where a held thing presses: each has touch sensors named PAD_taxel0, "
+        "PAD_taxel1, … across its width (MJCF sites and sensors)",
+    )
 
 
 class CameraConfig(StrictModel):

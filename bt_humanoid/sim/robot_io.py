@@ -85,6 +85,18 @@ class MujocoRobotIO:
         model = self.sim.model
         return model.site(int(model.sensor(name).objid[0])).name
 
+    def sensors_named(self, prefix: str) -> list[str]:
+        """The sensors whose names are ``prefix`` followed by 0, 1, 2, … (a pad's taxels), in that order."""
+        names, model = [], self.sim.model
+        while mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, f"{prefix}{len(names)}") >= 0:
+            names.append(f"{prefix}{len(names)}")
+        return names
+
+    def sensor_offset(self, name: str) -> np.ndarray:
+        """Where a site sensor measures, in the frame of the body it is on (the robot's own geometry)."""
+        model = self.sim.model
+        return model.site_pos[int(model.sensor(name).objid[0])].copy()
+
     def sensor(self, name: str) -> np.ndarray:
         """A sensor's reading (the robot's IMU, foot force and touch sensors), as of the last physics step; the IMU's
         rates and specific force with its white noise."""

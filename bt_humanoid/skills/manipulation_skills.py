@@ -15,7 +15,14 @@ import numpy as np
 import pinocchio as pin
 from pydantic import Field, model_validator
 
-from bt_humanoid.control.grasping import LIFT_HEIGHT, PAD_HALF_HEIGHT, GraspError, natural_hand_yaw, plan_grasp
+from bt_humanoid.control.grasping import (
+    LIFT_HEIGHT,
+    PAD_HALF_HEIGHT,
+    ROUND_KINDS,
+    GraspError,
+    natural_hand_yaw,
+    plan_grasp,
+)
 from bt_humanoid.control.keep_clear import (
     clearance_limits,
     hand_radius,
@@ -41,6 +48,7 @@ KEEPOUT_MARGIN = 0.03  # m added to the footprint radius when the base moves dur
 DESCEND_SPEED = 0.1  # m/s for the last few centimetres to a grasp or a placement
 RELEASE_GAP = 0.005  # m between a placed object's bottom and the surface when the gripper opens
 GRASP_WIDTH_TOLERANCE = 0.015  # m: a closed width further than this from the object's size is "something else"
+OFF_CENTRE_GRIP = 0.012  # m across the pads from their middle: pressed on the pads' outer fifth alone, held by an edge
 TUCKED_POSTURE = "tucked"  # robot.yaml posture for the idle arm near furniture
 CARRY_FORWARD = 0.38  # m ahead of the base centre where a held object is carried: clear of the chest
 CARRY_SIDE = 0.25  # m to the side of the working hand: outside the shoulder
@@ -540,7 +548,9 @@ class Grasp(_ManipulationSkill):
         )
 
     def _close(self) -> MotionHandle:
-        return self.context.robot.grippers.grasp(self.params.side)
+        # a round thing felt at the pads' edge is let go at once: closing on, the edges push it away or over
+        round_thing = self.target.kind in ROUND_KINDS
+        return self.context.robot.grippers.grasp(self.params.side, edge=OFF_CENTRE_GRIP if round_thing else None)
 
     def _check_grasp(self) -> None:
         width = self.context.robot.grippers.width(self.params.side)
@@ -550,8 +560,27 @@ class Grasp(_ManipulationSkill):
                 f"closed {width * 100:.1f} cm wide where the {self.target.name} is {self.grasp.width * 100:.1f} cm: "
                 "not holding it"
             )
+        off_centre = self.context.robot.grippers.pressure_centre(self.params.side)
+        if off_centre is not None and abs(off_centre) > OFF_CENTRE_GRIP:
+            # held by the pads' edge (it was not where the camera put it): lifted, it would hang by a few
+            # millimetres, and a person taking it would find the robot's pads where their fingers go
+            self.context.robot.grippers.command(self.params.side, "open")
+            self._felt_off_centre(off_centre)
+            raise PhaseFailure(
+                f"the {self.target.name} presses on the pads {abs(off_centre) * 100:.1f} cm off their middle "
+                "(felt by the pads): let go to grasp it afresh"
+            )
         self.target.held_by = self.params.side
         self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
+
+    def _felt_off_centre(self, off_centre: float) -> None:
+        """Move the belief of where the object stands the way the pads felt it: along the hand's y axis (across
+        the pads, level in a top-down grasp), by where it pressed; the next look refines it."""
+        whole_body = self.context.robot.whole_body
+        across = whole_body.frame_pose(whole_body.hand_frame(self.params.side)).rotation[:, 1].copy()
+        across[2] = 0.0
+        across /= max(float(np.linalg.norm(across)), 1e-9)
+        self.target.position = self.target.position + off_centre * across
 
     def _lift_off(self) -> MotionHandle | None:
         """A robot that balances with what it holds lifts it just off the surface first, to weigh it: lifted
@@ -638,6 +667,9 @@ class Grasp(_ManipulationSkill):
 
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt
+        felt = self.context.robot.grippers.pressure_centre(self.params.side) if self.phase == "close" else None
+        if felt is not None:
+            self._felt_off_centre(felt)  # stopped at the pads' edge: it stands that way
         if self.phase in ("descend", "close", "set it down again"):
             self.context.robot.grippers.command(self.params.side, "open")
         if self.phase == "descend":
