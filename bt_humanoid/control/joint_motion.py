@@ -32,6 +32,7 @@ class _Goal:
     target: np.ndarray | None  # None when braking
     settle_check: bool = True
     stall: dict = field(default_factory=dict)
+    tolerance: float = SETTLE_TOLERANCE  # rad (m) of tracking error that counts as arrived
 
 
 class JointReferenceController:
@@ -59,8 +60,15 @@ class JointReferenceController:
     def indices(self, joints: list[str]) -> np.ndarray:
         return np.array([self.io.index(j) for j in joints], dtype=int)
 
-    def move(self, targets: dict[str, float], speed_scale: float = 1.0, settle_check: bool = True) -> MotionHandle:
-        """Start moving ``targets`` (joint → position); returns the handle to poll."""
+    def move(
+        self,
+        targets: dict[str, float],
+        speed_scale: float = 1.0,
+        settle_check: bool = True,
+        tolerance: float = SETTLE_TOLERANCE,
+    ) -> MotionHandle:
+        """Start moving ``targets`` (joint → position); returns the handle to poll. It arrives when every joint
+        is within ``tolerance`` (rad, or m) of its target."""
         idx = self.indices(list(targets))
         goal_q = np.clip(np.array(list(targets.values()), dtype=float), self.io.lower[idx], self.io.upper[idx])
         handle = MotionHandle(f"moving {len(idx)} joint{'s' if len(idx) != 1 else ''}", on_cancel=self._cancelled)
@@ -70,7 +78,7 @@ class JointReferenceController:
         trajectory = plan_trajectory(
             self.position[idx], self.velocity[idx], self.acceleration[idx], goal_q, limits, phase_sync=False
         )
-        self.goals.append(_Goal(handle, idx, trajectory, self.io.time, goal_q, settle_check))
+        self.goals.append(_Goal(handle, idx, trajectory, self.io.time, goal_q, settle_check, tolerance=tolerance))
         return handle
 
     def track(self, joints: np.ndarray, position: np.ndarray, velocity: np.ndarray) -> None:
@@ -127,7 +135,7 @@ class JointReferenceController:
             self.goals.remove(goal)
             return
         error = np.abs(measured[goal.joints] - goal.target)
-        if np.all(error < SETTLE_TOLERANCE):
+        if np.all(error < goal.tolerance):
             goal.handle.succeed("arrived")
             self.goals.remove(goal)
         elif elapsed > goal.trajectory.duration + SETTLE_TIMEOUT:

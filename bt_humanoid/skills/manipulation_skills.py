@@ -234,6 +234,7 @@ class StandNearParams(StrictModel):
 STANCE_ARRIVAL = 0.15  # m: the first and last stretch at a stance may graze the map's margin round furniture
 STEP_BACK_TO_RAISE = 0.35  # m back from a surface before a folded arm swings out to the ready posture
 UNFOLDED = 0.2  # rad: an arm within this of the ready posture in every joint is ready already
+READY_TOLERANCE = 0.1  # rad (m for the lift) from the ready posture that counts as arrived there
 APPROACH_BACKOFF = 0.3  # m behind a stance, at most, where navigation may end before the straight last stretch
 
 
@@ -287,9 +288,12 @@ class StandNear(_ManipulationSkill):
         return back_up(self.context, STEP_BACK_TO_RAISE)
 
     def _raise_arm(self) -> MotionHandle | None:
-        """An empty working arm goes to the ready posture (a good start for reaches); a full one stays as carried."""
+        """An empty working arm goes to the ready posture (a good start for reaches); a full one stays as carried.
+
+        Near it is as good a start: a hand that a failed grasp left over the object may rest on it (a mug's
+        handle under a pad) a few hundredths of a radian short, and the hand rises over things next."""
         ready = self._ready_posture()
-        return self.context.robot.joints.move(ready) if ready else None
+        return self.context.robot.joints.move(ready, tolerance=READY_TOLERANCE) if ready else None
 
     def _hand_up(self) -> MotionHandle | None:
         """Raise the empty hand, held out at the ready posture, over the things it will pass as the base drives
