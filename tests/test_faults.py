@@ -137,7 +137,7 @@ def test_a_grasp_that_closes_off_the_object_s_centre_is_felt_let_go_and_taken_ag
 @pytest.mark.slow
 @pytest.mark.sim
 def test_a_cube_closed_on_by_the_pads_edge_is_felt_and_taken_again_before_it_is_handed_over():
-    """fetch_faults' episode 16: the cube nudged 3.6 cm across the pads, closed on by their last 7 mm. Held like
+    """fetch_faults' episode 16: the cube nudged 3.6 cm across the pads, closed on by their edge. Held like
     that, the person's fingers met the robot's pads and the cube fell to the floor; now the pads feel it at
     their edge, the hand lets go, and the cube taken by its middle ends in the person's hand."""
     events: list[dict] = []

@@ -29,12 +29,14 @@ class GripperController:
         self.joints = joints
         self.grippers = grippers
         self._grasps: dict[str, tuple[MotionHandle, float, float | None]] = {}
-        # per hand: its pads' taxels (touch sensors) and where each lies across the pads' width (m, the hand's y)
+        # per hand: its pads' taxels (touch sensors), and where each lies across the pads' width (m, the hand's y)
         self._taxels = {
-            side: [(name, float(joints.io.sensor_offset(name)[1]))
-                   for pad in config.tactile_pads for name in joints.io.sensors_named(f"{pad}_taxel")]
+            side: [name for pad in config.tactile_pads for name in joints.io.sensors_named(f"{pad}_taxel")]
             for side, config in grippers.items()
-        }  # fmt: skip
+        }
+        self._across = {
+            side: np.array([joints.io.sensor_offset(name)[1] for name in names]) for side, names in self._taxels.items()
+        }
 
     def grasp(self, side: str, edge: float | None = None) -> MotionHandle:
         """Close until the fingers stall; succeeds holding something, fails having closed on nothing.
@@ -111,11 +113,10 @@ class GripperController:
     def pressure_centre(self, side: str) -> float | None:
         """Where across the pads' width (m from their middle, along the hand's y axis) what they hold presses on
         them, from the taxels' forces; None for pads that feel nothing (or have no taxels)."""
-        taxels = self._taxels[side]
-        forces = np.array([float(self.joints.io.sensor(name)[0]) for name, _ in taxels])
-        if not len(taxels) or forces.sum() < MIN_PRESSURE:
+        forces = np.array([self.joints.io.sensor(name)[0] for name in self._taxels[side]])
+        if forces.sum() < MIN_PRESSURE:  # (no taxels: nothing felt)
             return None
-        return float(forces @ np.array([across for _, across in taxels]) / forces.sum())
+        return float(forces @ self._across[side] / forces.sum())
 
     def shut(self, side: str) -> bool:
         """The pads are together: nothing is between them."""

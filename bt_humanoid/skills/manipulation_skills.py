@@ -564,8 +564,8 @@ class Grasp(_ManipulationSkill):
                 f"closed {width * 100:.1f} cm wide where the {self.target.name} is {self.grasp.width * 100:.1f} cm: "
                 "not holding it"
             )
-        off_centre = self.context.robot.grippers.pressure_centre(self.params.side)
-        if off_centre is not None and abs(off_centre) > OFF_CENTRE_GRIP:
+        off_centre = self._felt_at_the_edge()
+        if off_centre is not None:
             # held by the pads' edge (it was not where the camera put it): lifted, it would hang by a few
             # millimetres, and a person taking it would find the robot's pads where their fingers go
             self.context.robot.grippers.command(self.params.side, "open")
@@ -576,6 +576,11 @@ class Grasp(_ManipulationSkill):
             )
         self.target.held_by = self.params.side
         self.target.grip_offset = self.grasp.position[2] - self.target.position[2]
+
+    def _felt_at_the_edge(self) -> float | None:
+        """Where across the pads the object presses (m from their middle), when that is at their edge."""
+        felt = self.context.robot.grippers.pressure_centre(self.params.side)
+        return felt if felt is not None and abs(felt) > OFF_CENTRE_GRIP else None
 
     def _felt_off_centre(self, off_centre: float) -> None:
         """Move the belief of where the object stands the way the pads felt it: along the hand's y axis (across
@@ -671,7 +676,7 @@ class Grasp(_ManipulationSkill):
 
     def on_failure(self) -> None:
         # a failed grasp leaves the hand open and above the object, ready for another attempt
-        felt = self.context.robot.grippers.pressure_centre(self.params.side) if self.phase == "close" else None
+        felt = self._felt_at_the_edge() if self.phase == "close" else None
         if felt is not None:
             self._felt_off_centre(felt)  # stopped at the pads' edge: it stands that way
         if self.phase in ("descend", "close", "set it down again"):
