@@ -1,5 +1,8 @@
 """Perception: the rendered RGB-D camera and the object detector, judged against the simulator."""
 
+import gc
+
+import mujoco
 import numpy as np
 import pytest
 
@@ -164,3 +167,36 @@ def test_find_searches_the_places_for_an_object_in_another_room():
     found = run.context.world_model.object(run.context.blackboard.get("mug"))
     assert np.linalg.norm(found.position - run.truth.object_centre("coffee mug")) < 0.02
     assert contacts == []
+
+
+def test_a_camera_dropped_without_closing_frees_its_own_textures_not_another_cameras():
+    # each camera has its own OpenGL context, and their textures and buffers have the same numbers: one that is
+    # garbage-collected must free them in its own context, or the camera still in use renders into nothing
+    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(2.0, 0.0, 0.0))
+    kept = RgbdCamera(run.sim, "head_camera", 320, 240)
+    kept.capture()
+    first = kept.geoms.copy()
+    dropped = RgbdCamera(run.sim, "head_camera", 320, 240)
+    dropped.capture()
+    kept.capture()  # the kept camera's context is the current one when the other goes
+    del dropped
+    gc.collect()
+    kept.capture()
+    kept.close()
+    assert (first >= 0).sum() > 0.5 * first.size
+    assert np.array_equal(kept.geoms, first)  # each pixel the same geom, not a colour of the last frame
+
+
+def test_the_robots_own_body_is_marked_from_its_geoms_and_hidden_from_the_detector():
+    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(2.0, 0.0, 0.0))
+    camera = RgbdCamera(run.sim, "head_camera", 320, 240)
+    sim = run.sim
+    sim.set_initial_joint(sim.robot.head_tilt, 1.2)  # looking down at its own chest and arms
+    mujoco.mj_forward(sim.model, sim.data)
+    frame = camera.capture()
+    camera.close()
+    assert frame is not None and frame.own_body is not None
+    own = np.isin(sim.model.geom_bodyid[camera.geoms.clip(0)], sorted(sim.robot_bodies)) & (camera.geoms >= 0)
+    assert own.sum() > 100 and np.array_equal(frame.own_body, own)
+    frame.hide(frame.own_body)
+    assert np.all(frame.depth[own] == 100.0) and frame.is_hidden(*np.argwhere(own)[0])

@@ -71,7 +71,7 @@ class RobotStack:
         self.perceiver: Perceiver | None = None
         if robot.cameras:  # objects are known only once the head camera has seen them
             camera = next(iter(robot.cameras))
-            self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera, self.sim.robot_root)
+            self.perceiver = Perceiver(self.sim, lambda: self.context.world_model, camera)
             self.robot.planners.append(self.perceiver)
             self.context.perceiver = self.perceiver
         self.separation = self._separation()

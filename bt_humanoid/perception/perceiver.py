@@ -17,9 +17,6 @@ import math
 import time
 from collections.abc import Callable
 
-import mujoco
-import numpy as np
-
 from bt_humanoid.perception.depth_filter import cleaned_depth
 from bt_humanoid.perception.detector import Detection, detect
 from bt_humanoid.perception.fusion import integrate
@@ -34,19 +31,13 @@ LOOK_RATE = 1.0  # Hz of background looks while a mission runs
 class Perceiver:
     """Keeps the WorldModel's objects up to date from the head camera."""
 
-    def __init__(self, sim: Simulation, world_model: Callable[[], WorldModel], camera: str, robot_root: str) -> None:
+    def __init__(self, sim: Simulation, world_model: Callable[[], WorldModel], camera: str) -> None:
         config = sim.robot.cameras[camera]
         self.camera = RgbdCamera(sim, camera, config.width, config.height)
         self.world_model = world_model
         self.period = 1.0 / LOOK_RATE
         self.last_look = -math.inf
         self.sim = sim
-        root = sim.model.body(robot_root).id
-        self._robot_geoms = np.array(
-            [sim.model.body_rootid[sim.model.geom_bodyid[g]] == root for g in range(sim.model.ngeom)]
-        )
-        self._segmentation = mujoco.Renderer(sim.model, config.height, config.width)
-        self._segmentation.enable_segmentation_rendering()
         self.learned = LearnedDetector.for_world(sim.world) if sim.world.detector is not None else None
         self.frames = 0
         self.look_times: list[float] = []  # wall seconds per look (capture, detection, fusion), for benchmarks
@@ -63,7 +54,6 @@ class Perceiver:
     def close(self) -> None:
         """Free the renderers; ``look()`` cannot be called afterwards."""
         self.camera.close()
-        self._segmentation.close()
         self.period = math.inf  # no more background looks
 
     def look(self) -> list[Detection]:
@@ -74,7 +64,8 @@ class Perceiver:
         if frame is None:
             return []  # no frame: the belief keeps what it had
         frame.depth = cleaned_depth(frame.depth)
-        self._mask_robot(frame)
+        if frame.own_body is not None:  # the robot's own pixels read as far away: nothing there for the detector
+            frame.hide(frame.own_body)
         belief = self.world_model()
         surfaces = list(belief.surfaces.values())
         detections = self.learned.detect(frame, surfaces) if self.learned is not None else detect(frame, surfaces)
@@ -84,16 +75,3 @@ class Perceiver:
         for listener in self.look_listeners:
             listener(frame, detections)
         return detections
-
-    def _mask_robot(self, frame: RgbdFrame) -> None:
-        """The robot's own pixels read as far away: nothing there for the detector."""
-        geoms = rendered_geoms(self._segmentation, self.sim.data, self.camera.camera)
-        frame.hide((geoms >= 0) & self._robot_geoms[np.maximum(geoms, 0)])
-
-
-def rendered_geoms(renderer: mujoco.Renderer, data: mujoco.MjData, camera: int) -> np.ndarray:
-    """The geom each pixel shows, -1 where none (a segmentation render from ``camera``)."""
-    renderer.update_scene(data, camera=camera)
-    segmentation = renderer.render()
-    is_geom = segmentation[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
-    return np.where(is_geom, segmentation[..., 0], -1)

@@ -1,6 +1,6 @@
 """The head RGB-D camera: rendered colour and depth frames, with intrinsics and pose from the MJCF.
 
-``mujoco.Renderer`` draws the scene off-screen (EGL) from the camera. Shadows,
+MuJoCo's OpenGL renderer draws the scene off-screen (EGL) from the camera. Shadows,
 reflections and the skybox are off: they cost most of the rendering time and
 a depth camera's colour stream has no use for them. Each frame carries what
 is needed to turn a pixel into a world point.
@@ -34,6 +34,7 @@ class RgbdFrame:
     time: float
     hidden: np.ndarray | None = None  # (H, W) bool: pixels where the robot's own body blocks the view
     noise: DepthModel | None = None  # the depth's noise, as the camera's data sheet gives it (None: exact)
+    own_body: np.ndarray | None = None  # (H, W) bool: pixels of the robot's own body, from its kinematic model
 
     def depth_sigma(self, distance: float) -> float:
         """σ (m) of a depth reading at ``distance`` m, square on (0 for an exact camera)."""
@@ -75,30 +76,59 @@ class RgbdFrame:
 
 # shadows, reflections and the sky cost most of a frame's rendering time and tell the detector nothing
 _OFF = (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION, mujoco.mjtRndFlag.mjRND_SKYBOX)
+# flat colours, one per geom: a pass that reads which geom each pixel shows, and depth more exactly far away
+_SEGMENT = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)
+
+
+class _OwnedGLContext(mujoco.GLContext):
+    """An OpenGL context freed only by its camera, after what was drawn with it: collected on its own, it could go
+    first, and MuJoCo's render context would then free its textures in whichever context is current."""
+
+    def __del__(self) -> None:
+        pass
 
 
 class RgbdCamera:
-    """Renders one MuJoCo camera at a fixed resolution, with the robot's sensor models (noise, missing depth)."""
+    """Renders one MuJoCo camera at a fixed resolution, with the robot's sensor models (noise, missing depth).
+
+    One frame is two passes of one OpenGL context: colour, then depth with each pixel's geom. The geoms give the
+    robot its own body's pixels (``RgbdFrame.own_body``: a real robot knows them from its kinematic model) and,
+    for training and benchmarks only, ``geoms``: the ground truth of what each pixel shows.
+    """
 
     def __init__(self, sim: Simulation, camera: str, width: int, height: int) -> None:
         self.sim = sim
         self.name = camera
         self.camera = sim.model.camera(camera).id
         self.width, self.height = width, height
-        self._colour = mujoco.Renderer(sim.model, height, width)
-        self._depth = mujoco.Renderer(sim.model, height, width)
-        self._depth.enable_depth_rendering()
-        fovy = math.radians(float(sim.model.cam_fovy[self.camera]))
+        model = sim.model
+        if width > model.vis.global_.offwidth or height > model.vis.global_.offheight:
+            raise ValueError(f"camera '{camera}': {width}×{height} exceeds the model's off-screen buffer")
+        self._gl = _OwnedGLContext(width, height)
+        self._gl.make_current()
+        self._context: mujoco.MjrContext | None = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._context)
+        self._context.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
+        self._scene = mujoco.MjvScene(model, maxgeom=10000)
+        self._option = mujoco.MjvOption()
+        self._view = mujoco.MjvCamera()
+        self._view.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        self._view.fixedcamid = self.camera
+        self._rect = mujoco.MjrRect(0, 0, width, height)
+        root = model.body(sim.robot_root).id
+        self._own_geoms = model.body_rootid[model.geom_bodyid] == root  # per geom: part of the robot
+        fovy = math.radians(float(model.cam_fovy[self.camera]))
         self.focal = (height / 2) / math.tan(fovy / 2)
         self.dropped_until = -math.inf  # s of simulation time: the camera delivers no frames before then
+        #: the last frame's geom per pixel (-1: none). Ground truth: for training and benchmarks, never for the robot
+        self.geoms = np.full((height, width), -1)
 
     def capture(self) -> RgbdFrame | None:
         """A frame, or None while the camera is dropped out (a covered lens, a driver restart)."""
         if self.sim.time < self.dropped_until:
             return None
         data = self.sim.data
-        rgb = self._render(self._colour)
-        depth = self._render(self._depth).astype(np.float64)
+        rgb, depth, self.geoms = self._render()
         models = self.sim.sensors
         # depth is lost on dark surfaces: how dark they are, not how the colour stream's noise shows them
         depth = depth_image(models.depth, depth, rgb, self.focal, self.sim.random_stream(f"{self.name}.depth"))
@@ -115,14 +145,64 @@ class RgbdCamera:
             rotation=rotation.copy(),
             time=self.sim.time,
             noise=models.depth if models.depth.enabled else None,
+            own_body=(self.geoms >= 0) & self._own_geoms[np.maximum(self.geoms, 0)],
         )
 
-    def _render(self, renderer: mujoco.Renderer) -> np.ndarray:
-        renderer.update_scene(self.sim.data, camera=self.camera)
+    def _render(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Exact colour (H, W, 3 uint8), depth (H, W, m) and geom per pixel (H, W; -1: none), top row first."""
+        model, scene, context = self.sim.model, self._scene, self._context
+        if context is None:
+            raise RuntimeError(f"camera '{self.name}' was closed")
+        self._gl.make_current()
+        mujoco.mjv_updateScene(model, self.sim.data, self._option, None, self._view, mujoco.mjtCatBit.mjCAT_ALL, scene)
         for flag in _OFF:
-            renderer.scene.flags[flag] = 0
-        return renderer.render()
+            scene.flags[flag] = 0
+        rgb = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        mujoco.mjr_render(self._rect, scene, context)
+        mujoco.mjr_readPixels(rgb, None, self._rect, context)
+        for flag in _SEGMENT:
+            scene.flags[flag] = 1
+        ids = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        depth = np.empty((self.height, self.width), dtype=np.float32)
+        mujoco.mjr_render(self._rect, scene, context)
+        mujoco.mjr_readPixels(ids, depth, self._rect, context)
+        for flag in _SEGMENT:
+            scene.flags[flag] = 0
+        # OpenGL's rows run bottom to top
+        return np.flipud(rgb), np.flipud(self._metres(depth)), np.flipud(self._geoms_of(ids))
+
+    def _metres(self, depth: np.ndarray) -> np.ndarray:
+        """Depth along the optical axis (m) from the depth buffer's reversed-Z values.
+
+        The clip planes in float32, as OpenGL's projection matrix holds them; the inversion in float64.
+        """
+        extent = self.sim.model.stat.extent
+        far = np.float32(self.sim.model.vis.map.zfar * extent)
+        near = np.float32(self.sim.model.vis.map.znear * extent)
+        c = np.float32(-0.5) * (-(far + near) / (far - near)) - np.float32(0.5)
+        d = np.float32(-0.5) * (-(np.float32(2) * far * near) / (far - near))
+        return (d / (depth.astype(np.float64) + c)).astype(np.float32).astype(np.float64)
+
+    def _geoms_of(self, ids: np.ndarray) -> np.ndarray:
+        """Geom per pixel from a segmentation pass's colours (each a scene geom's index plus one; 0: nothing)."""
+        scene = self._scene
+        geom_of_segment = np.full(scene.ngeom + 1, -1)
+        for g in scene.geoms[: scene.ngeom]:
+            if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
+                geom_of_segment[g.segid + 1] = g.objid
+        wide = ids.astype(np.int64)
+        segment = wide[..., 0] + wide[..., 1] * 256 + wide[..., 2] * 65536
+        return geom_of_segment[segment]
 
     def close(self) -> None:
-        self._colour.close()
-        self._depth.close()
+        """Free the OpenGL context; ``capture()`` cannot be called afterwards."""
+        if self._context is None:
+            return
+        with self._gl.as_current():  # its textures and buffers, not another camera's that share their numbers
+            self._context.free()
+        self._context = None
+        self._gl.free()
+
+    def __del__(self) -> None:
+        if hasattr(self, "_context"):  # not when __init__ failed before making it
+            self.close()

@@ -40,8 +40,37 @@ def _geom_extents(model: mujoco.MjModel, geom: int) -> tuple[np.ndarray, np.ndar
     return pos - half, pos + half
 
 
+RESTING_GAP = 1e-3  # m: a sleeping body's geom this close to another's (or into it) rests on it
+
+
 def geoms_touching(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> set[int]:
-    """The geoms in contact with ``body`` now."""
+    """The geoms in contact with ``body`` now.
+
+    A body at rest may sleep (the worlds enable MuJoCo's sleeping), and a sleeping body has no contacts in
+    ``data.contact``: it touches what its geoms are within ``RESTING_GAP`` of, as when it fell asleep.
+    """
+    if data.body_awake[body] == mujoco.mjtSleepState.mjS_ASLEEP:
+        return _geoms_resting_against(model, data, body)
     geom1, geom2 = data.contact.geom1[: data.ncon], data.contact.geom2[: data.ncon]
     bodies1, bodies2 = model.geom_bodyid[geom1], model.geom_bodyid[geom2]
     return set(geom2[bodies1 == body].tolist()) | set(geom1[bodies2 == body].tolist())
+
+
+def _geoms_resting_against(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> set[int]:
+    own = range(int(model.body_geomadr[body]), int(model.body_geomadr[body] + model.body_geomnum[body]))
+    touching: set[int] = set()
+    for geom in own:
+        for other in range(model.ngeom):
+            if model.geom_bodyid[other] == body or not _may_collide(model, geom, other):
+                continue
+            if mujoco.mj_geomDistance(model, data, geom, other, RESTING_GAP, None) < RESTING_GAP:
+                touching.add(other)
+    return touching
+
+
+def _may_collide(model: mujoco.MjModel, geom: int, other: int) -> bool:
+    """MuJoCo's contype/conaffinity test: one geom's type meets the other's affinity."""
+    return bool(
+        model.geom_contype[geom] & model.geom_conaffinity[other]
+        or model.geom_contype[other] & model.geom_conaffinity[geom]
+    )

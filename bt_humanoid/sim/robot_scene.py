@@ -57,6 +57,9 @@ def scene_spec(config: RobotConfig) -> mujoco.MjSpec:
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = 10
     spec.option.noslip_iterations = 5
+    # things at rest sleep (no collision or constraint work) until something awake touches or moves them; the
+    # robot and the people are actuated and never sleep
+    spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
     spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
     spec.visual.headlight.diffuse = [0.5, 0.5, 0.5]
     spec.add_texture(

@@ -23,7 +23,6 @@ import numpy as np
 
 from bt_humanoid.perception.depth_filter import cleaned_depth
 from bt_humanoid.perception.map_knowledge import map_world_model
-from bt_humanoid.perception.perceiver import rendered_geoms
 from bt_humanoid.perception.rgbd_camera import RgbdCamera, RgbdFrame
 from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.scene_config import Placement, SceneConfig
@@ -112,10 +111,6 @@ class ViewMaker:
         camera = next(iter(sim.robot.cameras))
         config_camera = sim.robot.cameras[camera]
         self.camera = RgbdCamera(sim, camera, config_camera.width, config_camera.height)
-        self._segmentation = mujoco.Renderer(model, config_camera.height, config_camera.width)
-        self._segmentation.enable_segmentation_rendering()
-        root = model.body(sim.robot_root).id
-        self._robot_geoms = np.array([model.body_rootid[model.geom_bodyid[g]] == root for g in range(model.ngeom)])
         #: per geom: the index of the instance it belongs to, -1 for anything else
         self._instance_of_geom = np.full(model.ngeom, -1)
         for index, instance in enumerate(self.instances):
@@ -124,7 +119,6 @@ class ViewMaker:
 
     def close(self) -> None:
         self.camera.close()
-        self._segmentation.close()
 
     def arrange(self, rng: np.random.Generator) -> list[int]:
         """A new random view; returns the instances standing on surfaces in it."""
@@ -153,8 +147,9 @@ class ViewMaker:
         frame = self.camera.capture()
         assert frame is not None
         frame.depth = cleaned_depth(frame.depth)  # as the robot's perceiver does
-        geoms = rendered_geoms(self._segmentation, self.sim.data, self.camera.camera)
-        frame.hide((geoms >= 0) & self._robot_geoms[np.maximum(geoms, 0)])
+        if frame.own_body is not None:
+            frame.hide(frame.own_body)
+        geoms = self.camera.geoms  # ground truth: the labels
         shown = np.where(geoms >= 0, self._instance_of_geom[np.maximum(geoms, 0)], -1)
         return frame, shown
 
