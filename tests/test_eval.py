@@ -193,12 +193,13 @@ def test_a_fault_counts_as_handled_when_recovered_or_stopped_safely_with_the_thi
         episode(1, False, "slip") | {"object_on_floor": False},  # failed, at rest, the thing on a surface
         episode(2, False, "slip") | {"object_on_floor": True},  # dropped
         episode(3, False, "push", contacts=1) | {"object_on_floor": False},  # touched someone
-        episode(4, False, "push", moving=True) | {"object_on_floor": False},  # not at rest
+        episode(4, False, "push") | {"object_on_floor": False, "moving_after_brake": True},  # not at rest
+        episode(5, False, "push", moving=True) | {"object_on_floor": False},  # failed mid-motion, braked to rest
     ]
     figures = summarize(episodes, wall_s=20.0, workers=1)
     handled = figures["by_fault_recovered_or_safe"]
     assert (handled["slip"]["successes"], handled["slip"]["episodes"]) == (2, 3)
-    assert handled["push"]["successes"] == 0
+    assert (handled["push"]["successes"], handled["push"]["episodes"]) == (1, 3)
     assert "by_fault_recovered_or_safe" not in summarize([episode(0, True, "slip")], wall_s=1.0, workers=1)
 
 

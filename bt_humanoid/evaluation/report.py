@@ -46,10 +46,15 @@ def _groups(episodes: list[dict[str, Any]], key: str, missing: str) -> dict[str,
 
 def safe_failure(episode: dict[str, Any]) -> bool:
     """A failure that left everyone and everything safe: the robot at rest and upright, no one touched, the thing
-    not dropped on the floor."""
+    not dropped on the floor.
+
+    At rest means after the executor braked: a tree that fails mid-motion ends with the robot moving, and braking
+    it is the stop (``ended_moving`` matters for a tree that reports success while it moves).
+    """
     hurt = episode["person_contacts"] > 0 or episode.get("fell", False)
-    moving = episode["ended_moving"] or episode["moving_after_brake"]
-    return not episode["success"] and not hurt and not moving and not episode.get("object_on_floor", True)
+    return not episode["success"] and not hurt and not episode["moving_after_brake"] and not episode.get(
+        "object_on_floor", True
+    )
 
 
 def _handled(episodes: list[dict[str, Any]]) -> dict[str, Any]:
