@@ -223,6 +223,18 @@ def test_what_the_camera_saw_is_forgotten_once_out_of_sight_for_a_while():
     assert grid.centre(rows, cols).tolist() == [[1.55, 1.55]]
 
 
+def test_the_clearance_follows_what_the_camera_sees_and_the_furniture_it_keeps():
+    grid = OccupancyGrid(np.array([[0.0, 0.0], [2.0, 2.0]]), 0.1)
+    grid.static[:, 0] = True  # a wall along x = 0
+    probe = np.array([[1.05, 1.05]])
+    assert grid.clearance_at(probe)[0] == pytest.approx(0.95)
+    grid.mark(np.array([[1.35, 1.05]]))  # something seen 0.3 m away: the furniture's field is not made again
+    assert grid.clearance_at(probe)[0] == pytest.approx(0.25)
+    grid.clear(*grid.cell(np.array([[1.35, 1.05]])))
+    grid.static[10, 12] = True  # furniture changed (a map edited in set-up): its field is made again
+    assert grid.clearance_at(probe)[0] == pytest.approx(0.15)
+
+
 @pytest.mark.sim
 def test_a_goal_in_the_table_ends_after_bounded_recovery_naming_the_goal(tmp_path, capsys):
     mission = tmp_path / "into_the_table.yaml"

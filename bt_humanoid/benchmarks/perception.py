@@ -78,16 +78,20 @@ def build_scene(rng: np.random.Generator, seed: int = 0):
     names = list(probe.sim.object_bodies)  # the objects of the run: the world's, or its scene's
     chosen = list(rng.choice(names, size=int(rng.integers(1, 5)), replace=False))
     (x0, y0), (x1, y1) = table.region
-    side = int(rng.integers(3))  # west, south, east: the chair blocks the north
-    distance = rng.uniform(0.7, 1.3)
-    along = rng.uniform(-0.3, 0.3)
     centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
-    if side == 0:
-        start = np.array([x0 - distance, centre[1] + along])
-    elif side == 1:
-        start = np.array([centre[0] + along, y0 - distance])
-    else:
-        start = np.array([x1 + distance, centre[1] + along])
+    footprint = probe.robot_config.base.footprint_radius
+    while True:  # a start clear of the furniture: a base put down in the storage box is pushed out of it
+        side = int(rng.integers(3))  # west, south, east: the chair blocks the north
+        distance = rng.uniform(0.7, 1.3)
+        along = rng.uniform(-0.3, 0.3)
+        if side == 0:
+            start = np.array([x0 - distance, centre[1] + along])
+        elif side == 1:
+            start = np.array([centre[0] + along, y0 - distance])
+        else:
+            start = np.array([x1 + distance, centre[1] + along])
+        if probe.navigator.grid.clearance_at(start[None, :])[0] > footprint:
+            break
     yaw = math.atan2(*(centre - start)[::-1]) + rng.uniform(-0.25, 0.25)
     run = RobotStack.load("apartment", "wheeled_humanoid", seed, robot_start=(*start, math.degrees(yaw)))
     spots: list[np.ndarray] = []

@@ -52,8 +52,11 @@ def safe_failure(episode: dict[str, Any]) -> bool:
     it is the stop (``ended_moving`` matters for a tree that reports success while it moves).
     """
     hurt = episode["person_contacts"] > 0 or episode.get("fell", False)
-    return not episode["success"] and not hurt and not episode["moving_after_brake"] and not episode.get(
-        "object_on_floor", True
+    return (
+        not episode["success"]
+        and not hurt
+        and not episode["moving_after_brake"]
+        and not episode.get("object_on_floor", True)
     )
 
 

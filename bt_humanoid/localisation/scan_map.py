@@ -8,6 +8,8 @@ Gauss-Newton matcher can follow its gradient (the likelihood-field idea of AMCL 
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import cv2
 import mujoco
 import numpy as np
@@ -39,6 +41,8 @@ class ScanMap:
         # one array of (distance, ∂/∂x, ∂/∂y) per cell: a lookup gathers each corner's three at once
         self._fields = np.stack([self.distance, gradient_x, gradient_y], axis=-1)
         self.occupied = occupied
+        for field in (self.distance, self._fields, self.occupied):  # robots may share one map: never written
+            field.flags.writeable = False
 
     @classmethod
     def from_world(cls, model: mujoco.MjModel, data: mujoco.MjData, bounds: np.ndarray, height: float) -> ScanMap:
@@ -51,7 +55,7 @@ class ScanMap:
         occupied[pad:-pad, pad:-pad] = False
         for footprint in fixed_footprints(model, data, (height - BAND, height + BAND)):
             fill_polygon(occupied, origin, RESOLUTION, footprint)
-        return cls(occupied, origin, RESOLUTION)
+        return _built(occupied.tobytes(), occupied.shape, (float(origin[0]), float(origin[1])))
 
     @classmethod
     def for_robot(cls, sim: Simulation) -> ScanMap:
@@ -76,3 +80,11 @@ class ScanMap:
                 (1 - fx) * fields[r + 1, c] + fx * fields[r + 1, c + 1]
             )
         return values[:, 0], values[:, 1], values[:, 2]
+
+
+@lru_cache(maxsize=2)
+def _built(cells: bytes, shape: tuple[int, int], origin: tuple[float, float]) -> ScanMap:
+    """The map of one floor plan, made once per process: every episode of a suite in one world has the same fixed
+    geometry (its fields are never written, so the robots of those episodes share it)."""
+    occupied = np.frombuffer(cells, dtype=bool).reshape(shape).copy()
+    return ScanMap(occupied, np.array(origin), RESOLUTION)

@@ -30,6 +30,8 @@ class OccupancyGrid:
         self.observed_padding = observed_padding  # m added around what the camera saw
         self._clearance: np.ndarray | None = None
         self._observed_distance = np.full(self.shape, np.inf)
+        self._static_distance: np.ndarray | None = None
+        self._static_for = self.static
 
     # ------------------------------------------------------------------ geometry
 
@@ -101,7 +103,11 @@ class OccupancyGrid:
         what it saw may be a person who moves.
         """
         if self._clearance is None:
-            static = self._distance(self.static, outside_occupied=True)
+            if self._static_distance is None or not np.array_equal(self._static_for, self.static):
+                # the furniture's field once: only what the camera sees changes during a run
+                self._static_for = self.static.copy()
+                self._static_distance = self._distance(self.static, outside_occupied=True)
+            static = self._static_distance
             self._observed_distance = self._distance(self.observed, outside_occupied=False)
             self._clearance = np.maximum(np.minimum(static, self._observed_distance - self.observed_padding), 0.0)
         return self._clearance

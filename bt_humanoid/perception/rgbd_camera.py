@@ -9,6 +9,8 @@ is needed to turn a pixel into a world point.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import mujoco
@@ -80,6 +82,21 @@ _OFF = (mujoco.mjtRndFlag.mjRND_SHADOW, mujoco.mjtRndFlag.mjRND_REFLECTION, mujo
 _SEGMENT = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)
 
 
+@contextmanager
+def _sensor_buffers(model: mujoco.MjModel, width: int, height: int) -> Iterator[None]:
+    """While a camera's render context is made: buffers for a sensor, not for a viewer (a recording's renderer
+    keeps the model's own). No multisampling: it doubles the rendering time, and a sensor's pixels are read one
+    by one. A frame of the camera's size, and the smallest shadow map: shadows are not drawn (a 4096² one took
+    most of the 80 ms a context took to make)."""
+    quality, buffer = model.vis.quality, model.vis.global_
+    kept = quality.offsamples, quality.shadowsize, buffer.offwidth, buffer.offheight
+    quality.offsamples, quality.shadowsize, buffer.offwidth, buffer.offheight = 0, 1, width, height
+    try:
+        yield
+    finally:
+        quality.offsamples, quality.shadowsize, buffer.offwidth, buffer.offheight = kept
+
+
 class _OwnedGLContext(mujoco.GLContext):
     """An OpenGL context freed only by its camera, after what was drawn with it: collected on its own, it could go
     first, and MuJoCo's render context would then free its textures in whichever context is current."""
@@ -106,10 +123,11 @@ class RgbdCamera:
             raise ValueError(f"camera '{camera}': {width}×{height} exceeds the model's off-screen buffer")
         self._gl = _OwnedGLContext(width, height)
         self._gl.make_current()
-        self._context: mujoco.MjrContext | None = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+        with _sensor_buffers(model, width, height):
+            self._context: mujoco.MjrContext | None = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._context)
         self._context.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
-        self._scene = mujoco.MjvScene(model, maxgeom=10000)
+        self._scene = mujoco.MjvScene(model, maxgeom=model.ngeom + model.nsite + 100)  # all it can draw, and some
         self._option = mujoco.MjvOption()
         self._view = mujoco.MjvCamera()
         self._view.type = mujoco.mjtCamera.mjCAMERA_FIXED
