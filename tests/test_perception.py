@@ -200,3 +200,22 @@ def test_the_robots_own_body_is_marked_from_its_geoms_and_hidden_from_the_detect
     assert own.sum() > 100 and np.array_equal(frame.own_body, own)
     frame.hide(frame.own_body)
     assert np.all(frame.depth[own] == 100.0) and frame.is_hidden(*np.argwhere(own)[0])
+
+
+def test_the_two_pass_frame_has_the_depth_and_geoms_of_mujocos_own_renderer():
+    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(2.0, 0.0, 0.0))
+    sim = run.sim
+    camera = RgbdCamera(sim, "head_camera", 320, 240)
+    _, depth, geoms = camera._render()
+    camera.close()
+    reference = mujoco.Renderer(sim.model, 240, 320)
+    reference.update_scene(sim.data, camera=camera.camera)
+    reference.enable_depth_rendering()
+    expected_depth = reference.render()
+    reference.enable_segmentation_rendering()
+    segmentation = reference.render()
+    reference.close()
+    expected_geoms = np.where(segmentation[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), segmentation[..., 0], -1)
+    assert (geoms >= 0).sum() > 0.5 * geoms.size
+    assert np.array_equal(geoms, expected_geoms)
+    assert np.array_equal(depth, expected_depth.astype(np.float64))

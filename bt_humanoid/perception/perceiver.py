@@ -1,7 +1,7 @@
 """The robot's perception loop: capture the head camera, detect, fuse into the WorldModel.
 
 It runs at a low rate while a mission runs (a rendered frame costs about
-20 ms of wall time) and on demand when a skill needs a fresh look
+15 ms of CPU time) and on demand when a skill needs a fresh look
 (``look()``). The camera's depth comes with its noise and holes (the robot's
 sensor models); small holes are filled (``depth_filter.py``) and the detector
 allows for the noise. The robot's own body is masked out of every frame from its

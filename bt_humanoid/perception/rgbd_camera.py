@@ -85,9 +85,9 @@ _SEGMENT = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)
 @contextmanager
 def _sensor_buffers(model: mujoco.MjModel, width: int, height: int) -> Iterator[None]:
     """While a camera's render context is made: buffers for a sensor, not for a viewer (a recording's renderer
-    keeps the model's own). No multisampling: it doubles the rendering time, and a sensor's pixels are read one
-    by one. A frame of the camera's size, and the smallest shadow map: shadows are not drawn (a 4096² one took
-    most of the 80 ms a context took to make)."""
+    keeps the model's own). No multisampling: it doubled the rendering time (an edge pixel shows one side's
+    colour, not a blend). A frame of the camera's size, and the smallest shadow map: shadows are not drawn (a
+    4096² one took most of the time a context took to make)."""
     quality, buffer = model.vis.quality, model.vis.global_
     kept = quality.offsamples, quality.shadowsize, buffer.offwidth, buffer.offheight
     quality.offsamples, quality.shadowsize, buffer.offwidth, buffer.offheight = 0, 1, width, height
@@ -119,8 +119,6 @@ class RgbdCamera:
         self.camera = sim.model.camera(camera).id
         self.width, self.height = width, height
         model = sim.model
-        if width > model.vis.global_.offwidth or height > model.vis.global_.offheight:
-            raise ValueError(f"camera '{camera}': {width}×{height} exceeds the model's off-screen buffer")
         self._gl = _OwnedGLContext(width, height)
         self._gl.make_current()
         with _sensor_buffers(model, width, height):
