@@ -50,3 +50,11 @@ def test_a_fetch_episode_run_twice_in_one_process_gives_identical_event_logs():
     assert any(e["event"] == "status" and "navigate" in e["node"] for e in logs[0]), "the episode drives somewhere"
     assert record["sim_time"] > 10
     assert logs[0] == logs[1]
+
+
+def test_opencv_works_on_one_thread_whatever_the_cores_so_runs_repeat_on_any_machine():
+    import cv2
+
+    stack = RobotStack.load("apartment", "wheeled_humanoid")
+    stack.close()
+    assert cv2.getNumThreads() == 1

@@ -14,6 +14,7 @@ from collections.abc import Callable
 # Off-screen rendering without a display needs EGL; set before mujoco loads.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
+import cv2
 import mujoco
 import numpy as np
 
@@ -28,6 +29,11 @@ from bt_humanoid.sim.sensor_models import SensorModels, ideal_sensors_requested
 from bt_humanoid.sim.standing import Stance, standing_posture
 from bt_humanoid.sim.walkers import WalkerDriver
 from bt_humanoid.sim.world_config import WorldConfig, load_world_config
+
+# OpenCV splits its work over the cores the process may use, and its results then differ in the last bits with
+# their number (a fetch episode ended otherwise pinned to one core than free on two): one thread, so a run is the
+# same run on any machine
+cv2.setNumThreads(1)
 
 
 class Simulation:
