@@ -219,3 +219,17 @@ def test_the_two_pass_frame_has_the_depth_and_geoms_of_mujocos_own_renderer():
     assert (geoms >= 0).sum() > 0.5 * geoms.size
     assert np.array_equal(geoms, expected_geoms)
     assert np.array_equal(depth, expected_depth.astype(np.float64))
+
+
+@pytest.mark.sim
+def test_the_perception_benchmarks_scenes_start_where_the_robot_believes_it_is():
+    # a start drawn inside the storage box had the base pushed out of it while its belief stayed: every
+    # detection of the scene then lay 8 cm off, and the benchmark's recall fell to 89 % with nobody the wiser
+    from bt_humanoid.benchmarks.perception import build_scene
+
+    rng = np.random.default_rng(0)
+    for index in range(8):
+        run, _ = build_scene(rng, seed=index)
+        believed, truth = run.robot.base.pose(), np.array(run.truth.robot_pose())
+        run.close()
+        assert np.hypot(*(believed[:2] - truth[:2])) < 0.01, f"scene {index}"
