@@ -58,3 +58,18 @@ def test_opencv_works_on_one_thread_whatever_the_cores_so_runs_repeat_on_any_mac
     stack = RobotStack.load("apartment", "wheeled_humanoid")
     stack.close()
     assert cv2.getNumThreads() == 1
+
+
+@pytest.mark.sim
+def test_a_run_leaves_the_garbage_collector_as_it_found_it(project_root, monkeypatch):
+    import gc
+
+    from bt_humanoid.engine.runner import GC_THRESHOLD
+
+    before = gc.get_threshold()
+    set_to: list[tuple[int, ...]] = []
+    original = gc.set_threshold
+    monkeypatch.setattr(gc, "set_threshold", lambda *values: (set_to.append(values), original(*values)))
+    run_scenario(project_root / "missions" / "demo.yaml", seed=7)
+    assert set_to[0][0] == GC_THRESHOLD > before[0], "the collector passes less often while the mission runs"
+    assert gc.get_threshold() == before and gc.get_freeze_count() == 0

@@ -5,7 +5,7 @@ It runs at a low rate while a mission runs (a rendered frame costs about
 (``look()``). The camera's depth comes with its noise and holes (the robot's
 sensor models); small holes are filled (``depth_filter.py``) and the detector
 allows for the noise. The robot's own body is masked out of every frame from its
-kinematic model (a segmentation render of the robot's geoms), as a real
+kinematic model (the camera's segmentation pass, read for the robot's geoms only), as a real
 robot filters itself out of its point cloud. A world whose world.yaml names a
 trained detector has its objects recognised by it (``learned_detector.py``);
 any other world's by shape rules (``detector.py``).
@@ -52,7 +52,7 @@ class Perceiver:
         pass  # nothing moves
 
     def close(self) -> None:
-        """Free the renderers; ``look()`` cannot be called afterwards."""
+        """Free the camera; ``look()`` cannot be called afterwards."""
         self.camera.close()
         self.period = math.inf  # no more background looks
 

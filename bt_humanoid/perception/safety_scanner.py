@@ -41,6 +41,7 @@ class SafetyScanner:
         self._own_geom = np.isin(model.geom_bodyid, sorted(own or ()))  # geoms of the robot's own bodies
         self.config = config
         self._angles = np.linspace(0.0, 2 * math.pi, config.rays, endpoint=False)
+        self._units = np.stack([np.cos(self._angles), np.sin(self._angles)], axis=1)  # each ray's way, scanner frame
         self._geom_ids = np.zeros(config.rays, dtype=np.int32)
         self._distances = np.zeros(config.rays)
         self.period = 1.0 / config.rate_hz
@@ -77,7 +78,7 @@ class SafetyScanner:
             ranges, returned = self.noise(ranges)
             hit &= returned
         # measured along each ray, in the scanner's own frame: where the robot is, it does not know from here
-        points = np.stack([np.cos(self._angles[hit]), np.sin(self._angles[hit])], axis=1) * ranges[hit, None]
+        points = self._units[hit] * ranges[hit, None]
         for listener in self.listeners:
             listener(points, now)
         return points

@@ -57,6 +57,8 @@ def geoms_touching(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> set
 
 
 def _geoms_resting_against(model: mujoco.MjModel, data: mujoco.MjData, body: int) -> set[int]:
+    """The geoms within ``RESTING_GAP`` of one of ``body``'s that MuJoCo would collide it with (the answer key's
+    question, asked rarely: each pair is a distance query)."""
     own = range(int(model.body_geomadr[body]), int(model.body_geomadr[body] + model.body_geomnum[body]))
     touching: set[int] = set()
     for geom in own:
