@@ -8,12 +8,17 @@ import pytest
 
 from bt_humanoid.perception.detector import colour_name, detect
 from bt_humanoid.perception.fusion import integrate
-from bt_humanoid.perception.rgbd_camera import RgbdCamera
+from bt_humanoid.perception.rgbd_camera import HIDDEN_DEPTH, RgbdCamera
 from bt_humanoid.testing.scenario import build_run
 
 
+def _standing_at(robot_start: tuple[float, float, float]):
+    """A run of a mission that does nothing, the robot standing at ``robot_start``: set-up for looking."""
+    return build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=robot_start)
+
+
 def _look(robot_start: tuple[float, float, float]):
-    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=robot_start)
+    run = _standing_at(robot_start)
     camera = RgbdCamera(run.sim, "head_camera", 320, 240)
     frame = camera.capture()
     camera.close()
@@ -172,7 +177,7 @@ def test_find_searches_the_places_for_an_object_in_another_room():
 def test_a_camera_dropped_without_closing_frees_its_own_textures_not_another_cameras():
     # each camera has its own OpenGL context, and their textures and buffers have the same numbers: one that is
     # garbage-collected must free them in its own context, or the camera still in use renders into nothing
-    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(2.0, 0.0, 0.0))
+    run = _standing_at((2.0, 0.0, 0.0))
     kept = RgbdCamera(run.sim, "head_camera", 320, 240)
     kept.capture()
     first = kept.geoms.copy()
@@ -188,7 +193,7 @@ def test_a_camera_dropped_without_closing_frees_its_own_textures_not_another_cam
 
 
 def test_the_robots_own_body_is_marked_from_its_geoms_and_hidden_from_the_detector():
-    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(2.0, 0.0, 0.0))
+    run = _standing_at((2.0, 0.0, 0.0))
     camera = RgbdCamera(run.sim, "head_camera", 320, 240)
     sim = run.sim
     sim.set_initial_joint(sim.robot.head_tilt, 1.2)  # looking down at its own chest and arms
@@ -199,11 +204,11 @@ def test_the_robots_own_body_is_marked_from_its_geoms_and_hidden_from_the_detect
     own = np.isin(sim.model.geom_bodyid[camera.geoms.clip(0)], sorted(sim.robot_bodies)) & (camera.geoms >= 0)
     assert own.sum() > 100 and np.array_equal(frame.own_body, own)
     frame.hide(frame.own_body)
-    assert np.all(frame.depth[own] == 100.0) and frame.is_hidden(*np.argwhere(own)[0])
+    assert np.all(frame.depth[own] == HIDDEN_DEPTH) and frame.is_hidden(*np.argwhere(own)[0])
 
 
 def test_the_two_pass_frame_has_the_depth_and_geoms_of_mujocos_own_renderer():
-    run = build_run({"mission": "look", "tree": {"wait": {"seconds": 0}}}, robot_start=(2.0, 0.0, 0.0))
+    run = _standing_at((2.0, 0.0, 0.0))
     sim = run.sim
     camera = RgbdCamera(sim, "head_camera", 320, 240)
     _, depth, geoms = camera._render()

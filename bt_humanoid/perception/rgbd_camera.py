@@ -126,6 +126,8 @@ class RgbdCamera:
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._context)
         self._context.readDepthMap = mujoco.mjtDepthMap.mjDEPTH_ZEROFAR
         self._scene = mujoco.MjvScene(model, maxgeom=model.ngeom + model.nsite + 100)  # all it can draw, and some
+        for flag in _OFF:  # the scene's flags stay as set: updating the scene does not touch them
+            self._scene.flags[flag] = 0
         self._option = mujoco.MjvOption()
         self._view = mujoco.MjvCamera()
         self._view.type = mujoco.mjtCamera.mjCAMERA_FIXED
@@ -171,8 +173,6 @@ class RgbdCamera:
             raise RuntimeError(f"camera '{self.name}' was closed")
         self._gl.make_current()
         mujoco.mjv_updateScene(model, self.sim.data, self._option, None, self._view, mujoco.mjtCatBit.mjCAT_ALL, scene)
-        for flag in _OFF:
-            scene.flags[flag] = 0
         rgb = np.empty((self.height, self.width, 3), dtype=np.uint8)
         mujoco.mjr_render(self._rect, scene, context)
         mujoco.mjr_readPixels(rgb, None, self._rect, context)
