@@ -17,11 +17,16 @@ On the open floor (worlds/open_floor), with the walking controller alone (docs/w
    the share survived, and the largest push survived towards each of eight directions while walking
    (bisection to 5 N over 0.2 s).
 
+``--largest-only --push-time 0.3 --directions 4 --phases 8`` measures only the largest push, over 0.3 s (the fetch
+suite's shove), towards four directions at eight moments of a stride: how strong a shove the walker takes
+depends on which foot is in the air when it comes (docs/walking.md, "Working on legs").
+
 A fall ends a run. Pinned to one core; ``--json PATH`` also writes the figures.
 """
 
 from __future__ import annotations
 
+import argparse
 import math
 import statistics
 import time
@@ -41,6 +46,7 @@ STANDING_HEIGHT = 0.4  # m: a pelvis below this has fallen
 PUSH_TIME = 0.2  # s
 SETTLE = 3.0  # s after a push before judging
 LOWEST, HIGHEST, RESOLUTION = 50.0, 400.0, 5.0  # N: the largest-push bisection's bracket and resolution
+FIRST_MOMENT, STRIDE = 2.0, 1.4  # s: walking is under way 2 s after setting off; a stride is two 0.7 s steps
 
 
 class Fell(Exception):
@@ -178,29 +184,29 @@ def start_stop() -> dict:
     }
 
 
-def survives(force: float, direction: float, speed: float, at: float) -> bool:
-    """A push of ``force`` N for PUSH_TIME towards ``direction`` (rad, world; the robot faces +x) at ``at`` s."""
+def survives(force: float, direction: float, speed: float, at: float, push_time: float = PUSH_TIME) -> bool:
+    """A push of ``force`` N for ``push_time`` s towards ``direction`` (rad, world; the robot faces +x) at ``at`` s."""
     trial = Trial()
     if speed > 0.0:
         trial.walker.command(speed)
     try:
         trial.run(at)
         trial.push = force * np.array([math.cos(direction), math.sin(direction), 0.0])
-        trial.push_until = trial.sim.time + PUSH_TIME
-        trial.run(PUSH_TIME + SETTLE)
+        trial.push_until = trial.sim.time + push_time
+        trial.run(push_time + SETTLE)
     except Fell:
         return False
     return True
 
 
-def pushes(count: int, impulse: float, speed: float, rng: np.random.Generator) -> dict:
-    """``count`` pushes of ``impulse`` N·s towards random directions at random moments (2 to 3.4 s: two gait
-    cycles once walking has started)."""
-    force = impulse / PUSH_TIME
+def pushes(count: int, impulse: float, speed: float, rng: np.random.Generator, push_time: float = PUSH_TIME) -> dict:
+    """``count`` pushes of ``impulse`` N·s over ``push_time`` s towards random directions at random moments (2 to
+    3.4 s: a stride once walking has started)."""
+    force = impulse / push_time
     survived = []
     for i in range(count):
-        direction, at = float(rng.uniform(0.0, 2 * math.pi)), float(rng.uniform(2.0, 3.4))
-        ok = survives(force, direction, speed, at)
+        direction, at = float(rng.uniform(0.0, 2 * math.pi)), float(rng.uniform(FIRST_MOMENT, FIRST_MOMENT + STRIDE))
+        ok = survives(force, direction, speed, at, push_time)
         survived.append(ok)
         print(
             f"    push {i + 1}/{count} {'walking' if speed else 'standing'} towards {math.degrees(direction):5.1f}° "
@@ -210,16 +216,40 @@ def pushes(count: int, impulse: float, speed: float, rng: np.random.Generator) -
     return {"pushes": count, "impulse_N_s": impulse, "speed_m_s": speed, "survived": sum(survived)}
 
 
-def largest_push(direction_deg: float, speed: float, at: float = 2.5) -> float:
-    """The largest force (N, for PUSH_TIME) survived towards ``direction_deg`` while walking at ``speed``."""
+def largest_push(direction_deg: float, speed: float, at: float = 2.5, push_time: float = PUSH_TIME) -> float:
+    """The largest force (N, for ``push_time`` s) survived towards ``direction_deg`` while walking at ``speed``,
+    pushed ``at`` s after setting off."""
     low, high = LOWEST, HIGHEST
     direction = math.radians(direction_deg)
-    if not survives(low, direction, speed, at):
+    if not survives(low, direction, speed, at, push_time):
         return 0.0
     while high - low > RESOLUTION:
         middle = (low + high) / 2
-        low, high = (middle, high) if survives(middle, direction, speed, at) else (low, middle)
+        low, high = (middle, high) if survives(middle, direction, speed, at, push_time) else (low, middle)
     return low
+
+
+def push_moments(phases: int) -> list[float]:
+    """When the largest push comes (s after setting off): 2.5 s for one; else ``phases`` moments spread over one
+    stride (two steps) once walking is under way, from 2.0 s."""
+    if phases == 1:
+        return [2.5]
+    return [round(FIRST_MOMENT + STRIDE * i / phases, 3) for i in range(phases)]
+
+
+def largest_pushes(directions: int, phases: int, speed: float, push_time: float) -> dict:
+    """The largest push survived towards each of ``directions`` directions, at each of ``push_moments(phases)``:
+    {direction (deg): {moment (s): N·s}} (N for ``push_time`` s before: N·s is what compares across durations)."""
+    largest: dict[str, dict[str, float]] = {}
+    for i in range(directions):
+        direction = 360.0 * i / directions
+        largest[f"{direction:g}"] = row = {}
+        for at in push_moments(phases):
+            row[f"{at:g}"] = largest_push(direction, speed, at, push_time) * push_time
+            print(
+                f"  largest push walking towards {direction:5.1f}° at {at:.2f} s: {row[f'{at:g}']:.1f} N·s", flush=True
+            )
+    return largest
 
 
 def _run(name: str, function, *args) -> dict:
@@ -231,6 +261,20 @@ def _run(name: str, function, *args) -> dict:
     return figures
 
 
+def _at_least_one(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} is not a count: give 1 or more")
+    return value
+
+
+def _seconds(text: str) -> float:
+    value = float(text)
+    if not 0.0 < value <= 2.0:
+        raise argparse.ArgumentTypeError(f"{value} s is not a push's length: give more than 0 and at most 2")
+    return value
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = benchmark_parser(__doc__, "pushes", 50, "random pushes while standing and again while walking")
     parser.add_argument("--seconds", type=float, default=60.0, help="straight walking (default 60 s)")
@@ -240,30 +284,40 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--impulse", type=float, default=30.0, help="N·s of each random push (default 30)")
     parser.add_argument("--push-speed", type=float, default=0.3, help="walking speed pushed at (default 0.3 m/s)")
     parser.add_argument("--directions", type=int, default=8, help="directions of the largest push (0: none)")
+    parser.add_argument(
+        "--phases",
+        type=_at_least_one,
+        default=1,
+        help="moments of a stride the largest push comes at (default 1: at 2.5 s)",
+    )
+    parser.add_argument(
+        "--push-time", type=_seconds, default=PUSH_TIME, help=f"s each push lasts (default {PUSH_TIME:g})"
+    )
+    parser.add_argument("--largest-only", action="store_true", help="measure only the largest push")
     args = parse_benchmark_args(parser, argv, "pushes")
     began = time.perf_counter()
     print(f"bt-humanoid walking benchmark ({ROBOT} on {WORLD}), seed {args.seed}")
-    figures: dict = {
-        "straight": _run(f"straight at {args.speed:g} m/s for {args.seconds:g} s", straight, args.seconds, args.speed),
-        "turn_in_place": _run("a full turn in place at 0.3 rad/s", turn_in_place),
-        "backwards": _run("backwards at 0.15 m/s for 10 s", constant, (-0.15, 0.0, 0.0), 10.0),
-        "sideways": _run("sideways at 0.05 m/s for 10 s", constant, (0.0, 0.05, 0.0), 10.0),
-        "arc": _run("an arc at 0.25 m/s, 0.2 rad/s for 20 s", constant, (0.25, 0.0, 0.2), 20.0),
-        "start_stop": _run("start and stop", start_stop),
-    }
-    rng = np.random.default_rng(args.seed)
-    print(f"  pushes of {args.impulse:g} N·s ({args.impulse / PUSH_TIME:.0f} N for {PUSH_TIME} s):")
-    figures["pushes_standing"] = pushes(args.pushes, args.impulse, 0.0, rng)
-    figures["pushes_walking"] = pushes(args.pushes, args.impulse, args.push_speed, rng)
-    for key in ("pushes_standing", "pushes_walking"):
-        result = figures[key]
-        print(f"  {key}: survived {result['survived']}/{result['pushes']}", flush=True)
-    largest = {}
-    for i in range(args.directions):
-        direction = 360.0 * i / args.directions
-        largest[f"{direction:g}"] = largest_push(direction, args.push_speed)
-        print(f"  largest push walking towards {direction:5.1f}°: {largest[f'{direction:g}']:.0f} N", flush=True)
-    figures["largest_push_walking_N"] = largest
+    figures: dict = {"push_time_s": args.push_time}
+    if not args.largest_only:
+        figures |= {
+            "straight": _run(
+                f"straight at {args.speed:g} m/s for {args.seconds:g} s", straight, args.seconds, args.speed
+            ),
+            "turn_in_place": _run("a full turn in place at 0.3 rad/s", turn_in_place),
+            "backwards": _run("backwards at 0.15 m/s for 10 s", constant, (-0.15, 0.0, 0.0), 10.0),
+            "sideways": _run("sideways at 0.05 m/s for 10 s", constant, (0.0, 0.05, 0.0), 10.0),
+            "arc": _run("an arc at 0.25 m/s, 0.2 rad/s for 20 s", constant, (0.25, 0.0, 0.2), 20.0),
+            "start_stop": _run("start and stop", start_stop),
+        }
+        rng = np.random.default_rng(args.seed)
+        force = args.impulse / args.push_time
+        print(f"  pushes of {args.impulse:g} N·s ({force:.0f} N for {args.push_time:g} s):")
+        figures["pushes_standing"] = pushes(args.pushes, args.impulse, 0.0, rng, args.push_time)
+        figures["pushes_walking"] = pushes(args.pushes, args.impulse, args.push_speed, rng, args.push_time)
+        for key in ("pushes_standing", "pushes_walking"):
+            result = figures[key]
+            print(f"  {key}: survived {result['survived']}/{result['pushes']}", flush=True)
+    figures["largest_push_walking_N_s"] = largest_pushes(args.directions, args.phases, args.push_speed, args.push_time)
     figures["wall_s"] = round(time.perf_counter() - began, 1)
     print(f"  wall time {figures['wall_s']:.0f} s")
     save_figures(args.json, figures)
