@@ -9,9 +9,10 @@ import pytest
 from bt_humanoid.evaluation.episode import run_episode, watch_people
 from bt_humanoid.language.embedded import EmbeddedPlanner
 from bt_humanoid.sim.people import FOREARM, SHOULDER_HEIGHT, SHOULDER_OUT, UPPER_ARM, arm_angles
+from bt_humanoid.sim.robot_config import load_robot_config
 from bt_humanoid.sim.scene_config import load_scene
 from bt_humanoid.sim.world_config import load_world_config
-from bt_humanoid.skills.arm_skills import PULL, taking_force
+from bt_humanoid.skills.arm_skills import taking_force
 from bt_humanoid.testing.scenario import Scenario, build_run
 from bt_humanoid.testing.told import told_planning_context
 
@@ -29,10 +30,13 @@ def test_the_person_s_arm_puts_the_wrist_where_asked_with_the_hand_level(reach: 
     assert elbow < 0  # the elbow below the line from shoulder to wrist, as people hold their arms
 
 
-def _hand_over(takes: bool = True, timeout: float = 20.0, tree: dict | None = None) -> Scenario:
+def _hand_over(
+    takes: bool = True, timeout: float = 20.0, tree: dict | None = None, robot: str = "wheeled_humanoid"
+) -> Scenario:
     mission = {
         "mission": "hand it over",
         "world": "kitchen",
+        "robot": robot,
         "scene": "holding_coke",
         "tree": tree or {"give": {"to": "person", "timeout": timeout}},
         "success": [{"delivered": "coke"}],
@@ -62,6 +66,19 @@ def test_the_person_takes_the_coke_and_the_robot_lets_go_when_it_feels_the_pull(
     assert states[let_go][1] in ("closing", "pulling"), "let go once their fingers were on it, not before"
     assert not scenario.touched  # type: ignore[attr-defined]
     assert "Please take the coke." not in scenario.run.stack.said, "taken before it had to ask"
+
+
+@pytest.mark.sim
+def test_the_biped_feels_the_person_take_the_coke_though_its_arm_yields_to_the_pull():
+    # the biped's arm follows its balance QP and gives way to the person's pull: the wrist feels 2 N, not the
+    # wheeled robot's 4 N, and with the wheeled robot's threshold it held on until its timeout (robot.yaml)
+    scenario = _hand_over(robot="biped_humanoid", timeout=8.0)
+    assert scenario.result.summary()["outcome"] == "success", scenario.result.summary()
+    assert scenario.truth.held_by_person("coke") == "person"
+    states = scenario.person_state  # type: ignore[attr-defined]
+    let_go = next(i for i, (hand, _) in enumerate(states) if hand is None)
+    assert states[let_go][1] in ("closing", "pulling"), "let go once their fingers were on it, not before"
+    assert not scenario.touched  # type: ignore[attr-defined]
 
 
 @pytest.mark.sim
@@ -136,4 +153,5 @@ def test_only_a_pull_towards_the_person_and_the_weight_they_take_count_as_taking
     assert taking_force(np.array([0.0, 0.0, 4.0]), hand, person) == 0.0  # pressed down on: not taken
     assert taking_force(np.array([-3.0, 0.0, -4.0]), hand, person) == pytest.approx(5.0)  # both at once
     assert taking_force(-6.0 * towards, hand, np.array([-1.0, 0.0])) == 0.0  # the same force, them behind
-    assert PULL < 5.0, "a 5 N pull and lift lets go"
+    for robot in ("wheeled_humanoid", "biped_humanoid"):
+        assert load_robot_config(robot).grippers["right"].taking_pull < 5.0, "a 5 N pull and lift lets go"

@@ -128,6 +128,13 @@ class GripperConfig(StrictModel):
         description="finger pads that feel where a held thing presses: each has touch sensors named PAD_taxel0, "
         "PAD_taxel1, … across its width (MJCF sites and sensors)",
     )
+    taking_pull: float = Field(
+        4.0,
+        gt=0,
+        le=50,
+        description="N of pull and lift at the wrist, felt for 0.15 s, that is a person taking what the hand holds "
+        "out (give): a stiff arm holds against their pull and feels it whole; an arm that yields to it feels less",
+    )
 
 
 class CameraConfig(StrictModel):

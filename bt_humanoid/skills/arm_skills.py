@@ -24,8 +24,7 @@ GIVE_HEIGHT = 1.0  # m
 # the thing out still. Only those two count: a person's fingers closing round a mug push it back towards the robot
 # by 4 N before they hold it, and a hand let go then dropped it (fetch episode 43).
 SETTLE = 0.5  # s the held-out hand is read still before the pull is looked for
-PULL = 4.0  # N of pull and lift together that is the person taking it ...
-PULL_FOR = 0.15  # s ... felt this long
+PULL_FOR = 0.15  # s the pull is felt for (its size is the gripper's ``taking_pull``, robot.yaml)
 # m the fingers open by: off the thing (by 3 cm, a pad the person's pull pressed a cube against stayed on it, and the
 # hand rising clear dragged the cube out of their fingers)
 LOOSEN = 0.06
@@ -176,7 +175,7 @@ class Give(_ManipulationSkill):
             self.still.append(force)
         elif force is not None and self.still:
             taking = self._taking(force - np.mean(self.still, axis=0))
-            if taking <= PULL:
+            if taking <= self.context.robot_config.grippers[p.side].taking_pull:
                 self.pulled_since = None
             elif self.pulled_since is None:
                 self.pulled_since = now
