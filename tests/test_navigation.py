@@ -451,3 +451,29 @@ def test_a_free_pose_near_a_taken_goal_is_the_nearest_with_room_facing_the_same_
         assert navigator.free_pose_near(goal, 1.0) == pytest.approx(goal), "a goal with room is kept"
     finally:
         run.stack.close()
+
+
+@pytest.mark.sim
+def test_a_robot_waiting_for_the_way_that_steps_out_first_goes_on_after_the_step():
+    """Waiting for a blocked way, a protective stop puts what the base scanner senses on the map and the robot
+    backs out before planning again. The wait must end as it moves: left standing, the navigator neither scanned
+    nor settled the step-out, and the robot stood there until the mission's time ran out (the biped's fetch
+    episode 16: 630 s, a walker passing it every 16 s)."""
+    run = build_run({"mission": "to the kitchen", "tree": {"wait": {"seconds": 0}}})
+    navigator = run.navigator
+    goal = _kitchen_taken(run)
+    handle = navigator.go_to(goal)
+    try:
+        assert navigator.waiting_since is not None, "blocked only by what was seen: it waits"
+        pose = run.robot.base.pose()
+        behind = pose[:2] - 0.1 * np.array([math.cos(pose[2]), math.sin(pose[2])])
+        # as if it stood too near what it now knows of to plan, until it has backed out
+        navigator.room_behind = lambda xy, yaw, longest: behind if math.dist(xy[:2], behind) > 0.03 else xy[:2]
+        navigator._plan_and_follow()  # what a protective stop's hold does once it has put the sensed on the map
+        assert navigator.stepping_out and navigator.waiting_since is None
+        run.executor.advance(5.0)
+        assert not navigator.stepping_out, "the step-out settled and the navigator planned again"
+        assert handle.done or navigator.route is not None or navigator.waiting_since is not None
+    finally:
+        navigator.halt()
+        run.stack.close()

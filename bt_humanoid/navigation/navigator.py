@@ -371,6 +371,8 @@ class Navigator:
         if out is None or np.allclose(out, pose[:2]):
             return False
         x, y = out
+        if self.waiting_since is not None:  # moving now: a wait left standing would hold the step-out forever
+            self._stop_waiting()
         self.stepping_out = True
         self.motion = self.robot.base.move_to(float(x), float(y), float(pose[2]), max_speed=self.max_speed)
         return True
