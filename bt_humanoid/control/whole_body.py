@@ -78,6 +78,16 @@ class WholeBodyGoal:
     qp: CompiledQp | None = None  # the tasks and limits compiled, when the goal starts
 
 
+class ReachHandle(MotionHandle):
+    """A reach's motion handle, which also says why a reach that failed fell short."""
+
+    def __init__(self, description: str, on_cancel: Callable[[MotionHandle], None] | None = None) -> None:
+        super().__init__(description, on_cancel)
+        #: the commanded pose itself stopped short of the target: a limit (a joint's range, a keep-out, the
+        #: torso's margin) held the hand back, not something it met; standing nearer is what helps
+        self.out_of_reach = False
+
+
 class WholeBodyController:
     """Runs one whole-body goal at a time over base, waist, arms and head."""
 
@@ -197,7 +207,7 @@ class WholeBodyController:
         if self.base_joints:
             tasks.append(DampingTask(self.base_joints, BASE_WEIGHT))
         frozen = [] if move_base else self.base_joints
-        handle = MotionHandle(f"reaching {distance * 100:.0f} cm with the {side} hand", on_cancel=self._cancelled)
+        handle = ReachHandle(f"reaching {distance * 100:.0f} cm with the {side} hand", on_cancel=self._cancelled)
         self.goal = WholeBodyGoal(
             handle,
             tasks,
@@ -310,8 +320,23 @@ class WholeBodyController:
         if arrived:
             self._finish(goal, True, "arrived" if miss is None else f"arrived within {miss * 100:.1f} cm")
         elif elapsed > goal.duration + SETTLE_TIMEOUT:
-            where = "" if miss is None else f"hand stopped {miss * 100:.1f} cm from its target: "
-            self._finish(goal, False, f"{where}blocked or out of reach")
+            self._finish(goal, False, self._why_short(goal))
+
+    def _why_short(self, goal: WholeBodyGoal) -> str:
+        """Why a goal's hand did not arrive: it lags the pose it was sent to (blocked: something holds it), or
+        that commanded pose itself stopped short (out of reach: a limit held the QP's answer back)."""
+        if goal.frame_task is None or goal.position_error is None:
+            return "blocked or out of reach"
+        miss = f"hand stopped {goal.position_error * 100:.1f} cm from its target"
+        self._update(self.kinematics, self.reference)
+        frame = goal.frame_task.frame
+        lag = float(np.linalg.norm(self.kinematics.pose(frame).translation - self.measured.pose(frame).translation))
+        commanded = float(np.linalg.norm(goal.frame_task.error(self.kinematics)[:3]))
+        if lag <= goal.tolerance[0] and commanded > goal.tolerance[0]:
+            if isinstance(goal.handle, ReachHandle):
+                goal.handle.out_of_reach = True
+            return f"{miss}: out of reach (the joints' limits hold it {commanded * 100:.1f} cm short)"
+        return f"{miss}: blocked ({lag * 100:.1f} cm behind where it was sent)"
 
     def _finish(self, goal: WholeBodyGoal, success: bool, message: str) -> None:
         self.goal = None

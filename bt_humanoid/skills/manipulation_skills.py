@@ -33,7 +33,7 @@ from bt_humanoid.control.keep_clear import (
 from bt_humanoid.control.motion import MotionHandle
 from bt_humanoid.control.stance import StanceError, working_stance
 from bt_humanoid.control.wbc.limits import BaseBoundsLimit, BaseKeepoutLimit, ClearanceLimit, JointRangeLimit, Limit
-from bt_humanoid.control.whole_body import READY_POSTURE, yaw_rotation
+from bt_humanoid.control.whole_body import READY_POSTURE, ReachHandle, yaw_rotation
 from bt_humanoid.perception.free_space import EDGE_MARGIN, MAX_SHIFT, nearest_free
 from bt_humanoid.perception.world_model import SupportSurface, TrackedObject, WorldModel
 from bt_humanoid.skills.context import CheckContext, SkillContext
@@ -683,7 +683,8 @@ class Grasp(_ManipulationSkill):
             self.context.robot.grippers.command(self.params.side, "open")
         if self.phase == "descend":
             self._note_short_reach(self.target, self.grasp.position)
-        if self.phase == "descend" and self.target.kind == "mug" and not self.target.yaw_known:
+        out_of_reach = isinstance(self.motion, ReachHandle) and self.motion.out_of_reach
+        if self.phase == "descend" and self.target.kind == "mug" and not self.target.yaw_known and not out_of_reach:
             # blocked on the way down: most likely a finger on the handle, which is not where it was guessed
             self.target.yaw += math.pi / 2
 
