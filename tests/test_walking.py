@@ -234,3 +234,33 @@ def test_the_bipeds_safety_scanner_drops_its_own_legs():
     assert blind is not None and len(blind) > 0  # the legs cross the scan plane
     scanner = SafetyScanner(sim.model, sim.data, root, config, own=sim.robot_bodies)
     assert len(scanner.scan()) == 0  # nothing on the open floor within range, and the legs are not something
+
+
+@pytest.mark.parametrize("bearing", [-48.0, 48.0, 90.0, 180.0])
+def test_the_bipeds_scanner_heads_see_a_person_beside_its_legs(bearing: float):
+    """A walker 1 m away where the shins hid them from one head between the legs (36-80° to either side ahead):
+    the biped's two heads, ahead of and behind its legs, see them at every bearing (fetch episode 16's walker
+    was hidden at -48° and touched)."""
+    start = (6.0, 0.0, 180.0)
+    sim = Simulation(
+        load_world_config("apartment_busy"), load_robot_config("biped_humanoid"), SceneConfig(robot_start=start)
+    )
+    walker = sim.walkers[0]
+    heading = math.radians(start[2] + bearing)
+    person = np.array([start[0] + math.cos(heading), start[1] + math.sin(heading)])
+    sim.data.qpos[walker.joints] = person - walker.start  # stood there for the test (the scene's script moves them)
+    mujoco.mj_forward(sim.model, sim.data)
+    root = sim.model.body(sim.robot_root).id
+    config = load_robot_config("biped_humanoid").scanner
+    assert config is not None and len(config.mounts) == 2
+
+    def hits_on_the_person(scanner_config) -> int:
+        points = SafetyScanner(sim.model, sim.data, root, scanner_config, own=sim.robot_bodies).scan()
+        pelvis, yaw = sim.data.xpos[root][:2], math.atan2(sim.data.xmat[root][3], sim.data.xmat[root][0])
+        turn = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        world = pelvis + points @ turn.T
+        return int(np.sum(np.hypot(*(world - person).T) < 0.4))
+
+    assert hits_on_the_person(config) >= 3
+    if abs(bearing) == 48.0:  # one head between the legs does not see them there
+        assert hits_on_the_person(config.model_copy(update={"mounts": [(0.0, 0.0)]})) == 0

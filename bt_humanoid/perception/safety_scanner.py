@@ -4,9 +4,12 @@ Mobile robots that work near people carry one (the head camera looks where
 the robot goes; the scanner also sees who comes from the side or behind).
 Each ray is cast through the scene (``raycast``) from the scanner's
 current pose, as a real scanner measures time of flight; the robot's own
-base is skipped, as a scanner's housing is. On a robot whose legs cross the
-scan plane, hits on its own bodies (``own``) are dropped: the legs blind those
-few rays, as they would a real scanner's.
+base is skipped, as a scanner's housing is. Hits on the robot's own bodies
+(``own``) are dropped: legs that cross the scan plane blind those rays, as
+they would a real scanner's. A robot with legs therefore carries more than one
+head (``ScannerConfig.mounts``: ahead of and behind its legs), as vehicles
+whose own structure blinds one scanner carry two at opposite corners; one scan
+is all the heads' hits, in the base's frame.
 """
 
 from __future__ import annotations
@@ -42,8 +45,12 @@ class SafetyScanner:
         self.config = config
         self._angles = np.linspace(0.0, 2 * math.pi, config.rays, endpoint=False)
         self._units = np.stack([np.cos(self._angles), np.sin(self._angles)], axis=1)  # each ray's way, scanner frame
-        self._geom_ids = np.zeros(config.rays, dtype=np.int32)
-        self._distances = np.zeros(config.rays)
+        self._mounts = np.array(config.mounts, dtype=float)  # (heads, 2): each head on the base, m
+        heads = len(self._mounts)
+        self._starts = np.repeat(self._mounts, config.rays, axis=0)  # (heads × rays, 2): each ray's head
+        self._ray_units = np.tile(self._units, (heads, 1))  # (heads × rays, 2): each ray's way
+        self._geom_ids = np.zeros(heads * config.rays, dtype=np.int32)
+        self._distances = np.zeros(heads * config.rays)
         self.period = 1.0 / config.rate_hz
         self.last_scan = -math.inf
         self.noise = noise
@@ -57,20 +64,24 @@ class SafetyScanner:
         self.last_scan = now
         position = self.data.xpos[self.base_body]
         yaw = math.atan2(self.data.xmat[self.base_body][3], self.data.xmat[self.base_body][0])
-        directions = np.zeros((self.config.rays, 3))
+        rays = self.config.rays
+        directions = np.zeros((rays, 3))
         directions[:, 0] = np.cos(self._angles + yaw)
         directions[:, 1] = np.sin(self._angles + yaw)
-        origin = np.array([position[0], position[1], self.config.height])
-        cast_rays(
-            self.model,
-            self.data,
-            origin,
-            directions,
-            self.config.range,
-            self._geom_ids,
-            self._distances,
-            self.base_body,
-        )
+        cos, sin = math.cos(yaw), math.sin(yaw)
+        for head, (ahead, left) in enumerate(self._mounts):
+            x, y = position[0] + cos * ahead - sin * left, position[1] + sin * ahead + cos * left
+            origin = np.array([x, y, self.config.height])
+            cast_rays(
+                self.model,
+                self.data,
+                origin,
+                directions,
+                self.config.range,
+                self._geom_ids[head * rays : (head + 1) * rays],
+                self._distances[head * rays : (head + 1) * rays],
+                self.base_body,
+            )
         hit = self._geom_ids >= 0
         hit[hit] = ~self._own_geom[self._geom_ids[hit]]
         ranges = self._distances
@@ -78,7 +89,7 @@ class SafetyScanner:
             ranges, returned = self.noise(ranges)
             hit &= returned
         # measured along each ray, in the scanner's own frame: where the robot is, it does not know from here
-        points = self._units[hit] * ranges[hit, None]
+        points = self._starts[hit] + self._ray_units[hit] * ranges[hit, None]
         for listener in self.listeners:
             listener(points, now)
         return points

@@ -151,6 +151,12 @@ class ScannerConfig(StrictModel):
     rays: int = Field(180, ge=8, le=2000, description="rays over the full circle")
     range: float = Field(4.0, gt=0, description="m beyond which nothing is seen")
     rate_hz: float = Field(50.0, gt=0, description="scans per second")
+    mounts: list[tuple[float, float]] = Field(
+        [(0.0, 0.0)],
+        min_length=1,
+        description="where each scanning head sits (m ahead of the base's centre, m to its left); each sweeps all "
+        "round with `rays` rays, and one scan is all of their hits",
+    )
 
 
 LEG_ROLES = ("hip_yaw", "hip_roll", "hip_pitch", "knee", "ankle_pitch", "ankle_roll")
