@@ -55,6 +55,12 @@ HELD_REMAP = 1.0
 # than the stance by them allows): each is chosen afresh on the map as it is then
 GOAL_RECHOICES = 5
 WAIT_LIMIT = 15.0  # s to wait, stopped, for a blocked way to clear before the goal fails
+# a new route longer than DETOUR times what was left of the blocked one, plus DETOUR_SLACK, is a way round: the
+# robot first waits up to DETOUR_WAIT for the way to clear, as someone walking across it does (a biped took 30
+# routes in 50 s to and fro beside a walker's loop, 7 m one way and 13 m round the other)
+DETOUR = 1.5
+DETOUR_SLACK = 1.0  # m
+DETOUR_WAIT = 6.0  # s
 FREE_SAMPLES = 12  # points along the low end of each ray that mark free cells
 # m a robot standing nearer furniture than its footprint allows a route to start (a biped works 0.25 m from a
 # table's edge, inside its 0.36 m footprint) steps straight back, at most, before it plans
@@ -95,7 +101,8 @@ class Navigator:
         self.route: Route | None = None
         self.motion: MotionHandle | None = None  # the follower's handle for the current route (or the step out)
         self.stepping_out = False  # backing straight out of a working stance before the first plan
-        self.waiting_since: float | None = None  # stopped because no route is free now
+        self.waiting_since: float | None = None  # stopped because no route is free now, or only a way round
+        self.way_left: float | None = None  # m of the route that got blocked still to go, when it did
         self.resume_tilt: float | None = None  # the head's tilt before a wait (it looks down at the goal meanwhile)
         self.remapped_hold: float | None = None  # the protective stop whose sensed things went on the map
         self.choose_goal: Callable[[], np.ndarray] | None = None  # the goal chosen afresh, when seen things take it
@@ -129,7 +136,7 @@ class Navigator:
             self.follower = RouteFollower(self.robot.base, self.robot.config.base, self.robot.control_period)
         self.goal, self.max_speed, self.replans = np.asarray(goal, dtype=float), self.robot.base.capped(max_speed), 0
         self.choose_goal, self.goals_chosen = choose_goal, 0
-        self.waiting_since = None
+        self.waiting_since, self.way_left = None, None
         self.stepping_out = False
         handle = MotionHandle(f"navigating to ({goal[0]:.2f}, {goal[1]:.2f})", on_cancel=lambda _: self.halt())
         self.handle = handle
@@ -310,6 +317,8 @@ class Navigator:
             if self.replans > MAX_REPLANS:
                 self._finish_goal(f"the way kept getting blocked: {MAX_REPLANS} new routes taken", brake=True)
                 return
+            if self.route is not None:
+                self.way_left = self.route.length - self.follower.progress
         try:
             route = self._plan_or_choose_again()
         except PlanError as error:
@@ -318,10 +327,21 @@ class Navigator:
             elif now - self.waiting_since > WAIT_LIMIT:
                 self._finish_goal(f"waited {WAIT_LIMIT:.0f} s for the way to clear: {error}", brake=True)
             return
+        if self._wait_instead_of(route, now):
+            if self.waiting_since is None:
+                self._wait(now)
+            return
         if self.waiting_since is not None:
             self._stop_waiting()
         self.route = route
         self.motion = self.follower.follow(route, self.max_speed)
+
+    def _wait_instead_of(self, route: Route, now: float) -> bool:
+        """Whether to wait for the blocked way to clear rather than take ``route``, a way round much longer than
+        what was left of it, until the robot has waited DETOUR_WAIT."""
+        if self.way_left is None or route.length <= DETOUR * self.way_left + DETOUR_SLACK:
+            return False
+        return self.waiting_since is None or now - self.waiting_since < DETOUR_WAIT
 
     def _speed_near_obstacles(self) -> float:
         """Slow down near what the camera saw: it may be a person who moves, or who has more to them than seen."""
