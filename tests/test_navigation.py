@@ -10,7 +10,7 @@ from py_trees.common import Status
 from bt_humanoid.cli import run_main
 from bt_humanoid.engine.composites import RoundRobin
 from bt_humanoid.navigation.follower import RouteFollower
-from bt_humanoid.navigation.navigator import DETOUR, DETOUR_WAIT, OBSERVED_MEMORY
+from bt_humanoid.navigation.navigator import DETOUR, DETOUR_WAIT, OBSERVED_MEMORY, WAIT_LIMIT
 from bt_humanoid.navigation.occupancy import OccupancyGrid
 from bt_humanoid.navigation.planner import SAMPLE_SPACING, Clearance, PlanError, Route, plan_route, pose_check
 from bt_humanoid.perception.depth_camera import DepthScan
@@ -474,6 +474,32 @@ def test_a_robot_waiting_for_the_way_that_steps_out_first_goes_on_after_the_step
         run.executor.advance(5.0)
         assert not navigator.stepping_out, "the step-out settled and the navigator planned again"
         assert handle.done or navigator.route is not None or navigator.waiting_since is not None
+    finally:
+        navigator.halt()
+        run.stack.close()
+
+
+@pytest.mark.sim
+def test_a_robot_held_again_mid_step_that_must_wait_stops_stepping_and_waits():
+    """A second protective stop's hold, while the robot backs out from the first, plans again from where it
+    stands and finds no way: the step is over and the wait is a plain one, which scans and gives up in time
+    (the biped's fetch episode 17 stood 720 s, stepping out and waiting at once)."""
+    run = build_run({"mission": "to the kitchen", "tree": {"wait": {"seconds": 0}}})
+    navigator = run.navigator
+    goal = _kitchen_taken(run)
+    handle = navigator.go_to(goal)
+    try:
+        pose = run.robot.base.pose()
+        behind = pose[:2] - 0.1 * np.array([math.cos(pose[2]), math.sin(pose[2])])
+        navigator.room_behind = lambda xy, yaw, longest: behind
+        navigator._plan_and_follow()  # the first hold: backing out
+        assert navigator.stepping_out
+        run.executor.advance(0.3)
+        navigator.room_behind = lambda xy, yaw, longest: xy[:2]  # the second hold: room enough, but no way
+        navigator._plan_and_follow()
+        assert not navigator.stepping_out and navigator.waiting_since is not None
+        run.executor.advance(WAIT_LIMIT + 2.0)
+        assert handle.done or navigator.waiting_since is None, "it gave up, or the way cleared and it went on"
     finally:
         navigator.halt()
         run.stack.close()

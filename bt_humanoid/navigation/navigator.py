@@ -248,6 +248,9 @@ class Navigator:
         A robot nearer furniture than a route may start first steps straight back (``_step_out``)."""
         if self._step_out():
             return
+        if self.stepping_out:  # planned again mid-step (a protective stop's hold): that step is over
+            self.stepping_out = False
+            self.robot.base.brake()
         try:
             route = self._plan_or_choose_again()
         except PlanError as error:
