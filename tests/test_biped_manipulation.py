@@ -15,7 +15,7 @@ from bt_humanoid.control.grasping import PAD_HALF_HEIGHT
 from bt_humanoid.control.stance import working_stance
 from bt_humanoid.control.wbc.dynamics import RobotDynamics
 from bt_humanoid.sim.sensor_models import IDEAL_SENSORS_VARIABLE
-from bt_humanoid.skills.manipulation_skills import STEP_IN, StandNear
+from bt_humanoid.skills.manipulation_skills import STEP_IN, Grasp, StandNear
 from bt_humanoid.testing.scenario import build_run
 from bt_humanoid.testing.scene import place_object
 from bt_humanoid.testing.told import tell_object_poses
@@ -176,28 +176,37 @@ def test_walking_in_to_the_counter_the_raised_hand_passes_over_the_mug_it_will_t
     assert run.truth.in_hand("coffee mug") == "right"
 
 
-def test_a_grasp_that_stops_short_to_the_side_brings_the_biped_a_step_along_the_edge(monkeypatch):
-    """A mug 0.24 m to the right of the stance, its handle to the east: the wrist cannot turn the hand to it there
-    and the hand stops 9 mm too far right, twice; the pick's replan stands 4 cm further left (once: the second
-    miss from the same stance adds nothing) and takes it. With exact sensors: with the sensors' noise the second
-    try from the first stance lands (the miss is that close), and the step along the edge is not needed."""
+def test_a_mug_the_hand_stops_a_centimetre_short_of_is_closed_on_from_there(monkeypatch):
+    """A mug 0.25 m in from the table's edge (fetch episode 18): the biped's arm stops its deep grip 1 cm short,
+    towards the robot along the line the pads close on, and 4 mm high. Before, the grasp failed out of reach,
+    twice, and again from a stance a step nearer; now it closes there, once: the nearer pad meets the mug first
+    and pushes it to the other."""
     monkeypatch.setenv(IDEAL_SENSORS_VARIABLE, "1")
-    trial = Trial("mug", "west", (2.973, -0.195), -0.018, (2.947, 0.005), (2.25, 0.045, 0.0))
+    trial = Trial("mug", "south", (3.44, -0.194), -2.967, (3.2, -0.3), (3.44, -0.75, 90.0))
     run = prepare_trial(trial, "told", "biped_humanoid")
-    stances: list[float] = []  # the base's y each time a grasp starts
-    run.events.listeners.append(
-        lambda e: (
-            e["event"] == "status"
-            and e.get("node", "").endswith("grasp")
-            and e["new"] == "RUNNING"
-            and stances.append(run.truth.robot_pose()[1])
-        )
-    )
+    settled: list[float] = []  # how far from its plan each descent that stopped short closed
+    settle_for = Grasp.settle_for
+
+    def settle_and_note(skill: Grasp, motion) -> bool:
+        planned = skill.grasp.position.copy()
+        if not settle_for(skill, motion):
+            return False
+        settled.append(float(np.linalg.norm(skill.grasp.position - planned)))
+        return True
+
+    monkeypatch.setattr(Grasp, "settle_for", settle_and_note)
+    grasps = []  # each grasp the pick starts
+
+    def note_grasp(event: dict) -> None:
+        if event["event"] == "status" and event.get("node", "").endswith("grasp") and event["new"] == "RUNNING":
+            grasps.append(event)
+
+    run.events.listeners.append(note_grasp)
     result = run.execute()
     run.stack.close()
     assert result.success, result.cause
-    assert len(stances) >= 3  # two attempts from the first stance, then one from the next
-    assert stances[-1] == pytest.approx(stances[0] + 0.04, abs=0.015)  # 4 cm to the left (north), not 8
+    assert len(grasps) == 1  # no retry, no replan
+    assert len(settled) == 1 and 0.005 < settled[0] < 0.02, settled  # it closed short of its plan, by about 1 cm
     assert _placed_within(run, "coffee mug", trial.place) and run.truth.upright("coffee mug")
 
 

@@ -11,9 +11,11 @@ import pytest
 from bt_humanoid.benchmarks.kitchen_manipulation import Kitchen, Outcome, Trial, mission_of, scene_of, summarize, table
 from bt_humanoid.cli import validate_main
 from bt_humanoid.control.grasping import (
+    HOLD_DEPTH,
     OPENING_MARGIN,
     PAD_HALF_HEIGHT,
     PALM_ABOVE_GRIP,
+    STOPPED_PAD_CLEARANCE,
     GraspError,
     hand_yaws,
     plan_grasp,
@@ -316,3 +318,27 @@ def test_the_kitchen_table_says_what_each_rate_is_counted_over():
     assert "grasp | of all" in header and "place | of grasped" in header and "into bin | of all" in header
     assert "5/6 83%" in row and "2/3 67%" in row and "2/4 50%" in row and "1/2 50%" in row
     assert total.split()[0] == "all"
+
+
+def test_a_grasp_that_stops_short_still_closes_a_little_high_or_off_along_the_closing_line_but_not_across_it():
+    mug = _thing("mug", (0.11, 0.08, 0.09), yaw=0.0)  # closed on along y (across the handle)
+    grasp = plan_grasp(mug, TABLE, math.pi / 2, OPENING)
+    assert grasp.give == pytest.approx(mug.top - (grasp.position[2] - PAD_HALF_HEIGHT) - HOLD_DEPTH)
+    assert grasp.sway == pytest.approx((OPENING - 0.08) / 2 - STOPPED_PAD_CLEARANCE)
+
+    def closes(dx: float, dy: float, dz: float, dyaw: float = 0.0) -> bool:
+        return grasp.closes_from(grasp.position + np.array([dx, dy, dz]), grasp.yaw + dyaw, 0.1, 0.008)
+
+    assert closes(0.0, 0.0, 0.0)
+    assert closes(0.0, -0.011, 0.004)  # a biped's hand 1.1 cm short along the closing line, 4 mm high
+    assert closes(0.0, 0.0, grasp.give - 1e-4) and not closes(0.0, 0.0, grasp.give + 1e-4)
+    assert closes(0.0, grasp.sway - 1e-4, 0.0) and not closes(0.0, grasp.sway + 1e-4, 0.0)
+    assert closes(0.0, 0.008, -0.002)  # as low as a reach that arrived may end
+    assert not closes(0.0, 0.0, -0.009)  # lower: nearer the table than a reach may go
+    assert not closes(0.009, 0.0, 0.0)  # across the closing line: the pads would meet it off their middle
+    assert not closes(0.0, 0.0, 0.0, dyaw=0.15)
+
+
+def test_a_flat_thing_gives_no_room_to_close_higher():
+    bar = _thing("bar", (0.1, 0.04, 0.022))
+    assert plan_grasp(bar, TABLE, 0.0, OPENING).give == 0.0

@@ -19,6 +19,11 @@ The grip site goes as high as the palm allows (tall things stay steady),
 never so low that the pads touch the surface, and low enough that the pads
 reach down over the object's top: a flat thing (an energy bar 2.2 cm high)
 is held with the pads just above the surface, the grip site above its top.
+A grip may close a little off its plan when the hand cannot reach it (a
+biped's arm at the far side of its reach): higher, as long as the pads still
+reach ``HOLD_DEPTH`` down the object's sides, and off-centre along the line
+the pads close on, as long as the open pads stay clear of the object's sides
+(the nearer pad meets the object first and pushes it to the other).
 """
 
 from __future__ import annotations
@@ -41,6 +46,12 @@ LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
 # m the open pads must clear the object by, in total: the descent ends within 8 mm of its target and 0.1 rad of
 # its yaw, so a pad 1.5 cm from the object's side cannot land on its top
 OPENING_MARGIN = 0.03
+# m an open pad that stopped beside an object (the descent done, not blocked) must still clear its side by: the
+# belief's error in where the object stands
+STOPPED_PAD_CLEARANCE = 0.005
+# m the pads' lower edge must reach below an object's top for a grip that closes higher than planned: half a
+# mug's height, with the pads (6 cm tall) touching its side over 5 cm
+HOLD_DEPTH = 0.05
 COMFORTABLE_SLACK = 0.05  # m in total: a width with less slack is taken only when no other fits with more
 
 # hand yaw relative to the base heading that suits either arm best for top-down grasps: the fingers close
@@ -57,6 +68,8 @@ class Grasp:
     position: np.ndarray  # grip-site position at the grasp (world)
     yaw: float  # hand yaw (rad); the fingers close along the hand's x axis at this yaw
     width: float  # expected distance between the pads when closed on the object (m)
+    give: float = 0.0  # m above ``position`` the grip site may close and still hold (the pads reach HOLD_DEPTH down)
+    sway: float = 0.0  # m off ``position`` along the closing line the grip site may close (the open pads clear it)
 
     @property
     def pre_grasp(self) -> np.ndarray:
@@ -65,6 +78,21 @@ class Grasp:
     @property
     def lifted(self) -> np.ndarray:
         return self.position + np.array([0.0, 0.0, LIFT_HEIGHT])
+
+    def closes_from(self, grip_site: np.ndarray, yaw: float, yaw_tolerance: float, tolerance: float) -> bool:
+        """Whether a hand whose grip site stopped at ``grip_site``, turned to ``yaw``, short of this grasp still
+        closes on the object: within ``tolerance`` m across the closing line, below the grasp and ``yaw_tolerance``
+        rad of its yaw (as a reach that arrived), off along the line by no more than the sway, and above by no more
+        than the give."""
+        off = np.asarray(grip_site, dtype=float) - self.position
+        along = np.array([math.cos(self.yaw), math.sin(self.yaw)])  # the fingers close along the hand's x
+        across = abs(float(off[0] * -along[1] + off[1] * along[0]))
+        return (
+            abs(wrap_angle(yaw - self.yaw)) <= yaw_tolerance
+            and across <= tolerance
+            and abs(float(off[:2] @ along)) <= self.sway
+            and -tolerance <= float(off[2]) <= self.give
+        )
 
 
 class GraspError(ValueError):
@@ -119,5 +147,8 @@ def plan_grasp(obj: TrackedObject, support_height: float, hand_yaw: float, max_o
         )
     roomy = [(yaw, width) for yaw, width in fitting if width <= max_opening - COMFORTABLE_SLACK]
     yaw, width = min(roomy or fitting, key=lambda option: abs(wrap_angle(option[0] - hand_yaw)))
-    position = np.array([obj.position[0], obj.position[1], grip_height(obj, support_height)])
-    return Grasp(position, yaw, width)
+    height = grip_height(obj, support_height)
+    depth = obj.top - (height - PAD_HALF_HEIGHT)  # how far below the top the pads' lower edge reaches
+    position = np.array([obj.position[0], obj.position[1], height])
+    sway = (max_opening - width) / 2 - STOPPED_PAD_CLEARANCE  # each open pad still clears the object's side
+    return Grasp(position, yaw, width, give=max(0.0, depth - HOLD_DEPTH), sway=max(0.0, sway))

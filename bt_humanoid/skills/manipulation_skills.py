@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -46,6 +47,8 @@ Side = Literal["left", "right"]
 APPROACH_CLEARANCE = 0.06  # m the hand (or what it holds) keeps above a surface while moving over it
 KEEPOUT_MARGIN = 0.03  # m added to the footprint radius when the base moves during a reach
 DESCEND_SPEED = 0.1  # m/s for the last few centimetres to a grasp or a placement
+# m and rad a grasp's descent ends within: a pad 1.5 cm from the object's side cannot land on its top
+DESCEND_TOLERANCE = (0.008, 0.1)
 RELEASE_GAP = 0.005  # m between a placed object's bottom and the surface when the gripper opens
 GRASP_WIDTH_TOLERANCE = 0.015  # m: a closed width further than this from the object's size is "something else"
 OFF_CENTRE_GRIP = 0.012  # m across the pads from their middle: pressed on the pads' outer fifth alone, held by an edge
@@ -548,8 +551,20 @@ class Grasp(_ManipulationSkill):
             speed=DESCEND_SPEED,
             gaze=self.target.position,
             limits=[*self._keepout(self.surface.region), *self._open_hand(self.params.side)],
-            tolerance=(0.008, 0.1),
+            tolerance=DESCEND_TOLERANCE,
         )
+
+    def settle_for(self, motion: MotionHandle) -> bool:
+        """A descent that the arm's reach stopped short of its grip, but near enough that the grip still holds (a
+        little higher, or off along the line the pads close on), closes where it is: no stance gets nearer."""
+        if self.phase != "descend" or not (isinstance(motion, ReachHandle) and motion.out_of_reach):
+            return False
+        side = self.params.side
+        hand = self._hand_xyz(side)
+        if not self.grasp.closes_from(hand, self._hand_yaw(side), DESCEND_TOLERANCE[1], DESCEND_TOLERANCE[0]):
+            return False
+        self.grasp = replace(self.grasp, position=hand)  # where it holds: what the put lowers by
+        return True
 
     def _close(self) -> MotionHandle:
         # a round thing felt at the pads' edge is let go at once: closing on, the edges push it away or over

@@ -65,7 +65,7 @@ class PhasedSkill(Skill):
             if self.motion.status is MotionStatus.RUNNING:
                 self.feedback_message = f"{self.phase}: {self.motion.feedback}"
                 return Status.RUNNING
-            if self.motion.status is not MotionStatus.SUCCEEDED:
+            if self.motion.status is not MotionStatus.SUCCEEDED and not self.settle_for(self.motion):
                 self.feedback_message = f"{self.phase}: {self.motion.result}"
                 self.on_failure()
                 return Status.FAILURE
@@ -89,6 +89,11 @@ class PhasedSkill(Skill):
             return self.context.world_model.surface(name)
         except KeyError as error:
             raise PhaseFailure(error.args[0]) from None
+
+    def settle_for(self, motion: MotionHandle) -> bool:
+        """Whether the current phase may go on from where its failed ``motion`` left the robot (a reach that
+        stopped short, but near enough for what comes next); by default it may not."""
+        return False
 
     def on_failure(self) -> None:
         """Called once when a phase's motion fails; leave the robot safe (e.g. open an empty gripper)."""
