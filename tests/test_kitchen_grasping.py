@@ -327,7 +327,7 @@ def test_a_grasp_that_stops_short_still_closes_a_little_high_or_off_along_the_cl
     assert grasp.sway == pytest.approx((OPENING - 0.08) / 2 - STOPPED_PAD_CLEARANCE)
 
     def closes(dx: float, dy: float, dz: float, dyaw: float = 0.0) -> bool:
-        return grasp.closes_from(grasp.position + np.array([dx, dy, dz]), grasp.yaw + dyaw, 0.1, 0.008)
+        return grasp.closes_from(grasp.position + np.array([dx, dy, dz]), grasp.yaw + dyaw, (0.008, 0.1))
 
     assert closes(0.0, 0.0, 0.0)
     assert closes(0.0, -0.011, 0.004)  # a biped's hand 1.1 cm short along the closing line, 4 mm high

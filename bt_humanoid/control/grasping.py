@@ -43,8 +43,10 @@ TOP_CLEARANCE = 0.008  # m: palm stays this far above the object's top
 MIN_PAD_OVERLAP = 0.01  # m: the pads reach at least this far down the object's sides from its top
 PRE_GRASP_HEIGHT = 0.1  # m above the grasp: the hand comes down from here
 LIFT_HEIGHT = 0.1  # m the object is lifted before it counts as picked
-# m the open pads must clear the object by, in total: the descent ends within 8 mm of its target and 0.1 rad of
-# its yaw, so a pad 1.5 cm from the object's side cannot land on its top
+# m and rad a grasp's descent ends within, of its target and of its yaw
+DESCEND_TOLERANCE = (0.008, 0.1)
+# m the open pads must clear the object by, in total: within DESCEND_TOLERANCE of the grasp, a pad 1.5 cm from
+# the object's side cannot land on its top
 OPENING_MARGIN = 0.03
 # m an open pad that stopped beside an object (the descent done, not blocked) must still clear its side by: the
 # belief's error in where the object stands
@@ -79,19 +81,22 @@ class Grasp:
     def lifted(self) -> np.ndarray:
         return self.position + np.array([0.0, 0.0, LIFT_HEIGHT])
 
-    def closes_from(self, grip_site: np.ndarray, yaw: float, yaw_tolerance: float, tolerance: float) -> bool:
+    def closes_from(
+        self, grip_site: np.ndarray, yaw: float, tolerance: tuple[float, float] = DESCEND_TOLERANCE
+    ) -> bool:
         """Whether a hand whose grip site stopped at ``grip_site``, turned to ``yaw``, short of this grasp still
-        closes on the object: within ``tolerance`` m across the closing line, below the grasp and ``yaw_tolerance``
-        rad of its yaw (as a reach that arrived), off along the line by no more than the sway, and above by no more
-        than the give."""
+        closes on the object: within ``tolerance`` (m, rad) across the closing line, below the grasp and of its
+        yaw (as a descent that arrived), off along the line by no more than the sway, and above by no more than
+        the give."""
         off = np.asarray(grip_site, dtype=float) - self.position
         along = np.array([math.cos(self.yaw), math.sin(self.yaw)])  # the fingers close along the hand's x
         across = abs(float(off[0] * -along[1] + off[1] * along[0]))
+        position_tolerance, yaw_tolerance = tolerance
         return (
             abs(wrap_angle(yaw - self.yaw)) <= yaw_tolerance
-            and across <= tolerance
+            and across <= position_tolerance
             and abs(float(off[:2] @ along)) <= self.sway
-            and -tolerance <= float(off[2]) <= self.give
+            and -position_tolerance <= float(off[2]) <= self.give
         )
 
 

@@ -17,6 +17,7 @@ import pinocchio as pin
 from pydantic import Field, model_validator
 
 from bt_humanoid.control.grasping import (
+    DESCEND_TOLERANCE,
     LIFT_HEIGHT,
     PAD_HALF_HEIGHT,
     ROUND_KINDS,
@@ -47,8 +48,6 @@ Side = Literal["left", "right"]
 APPROACH_CLEARANCE = 0.06  # m the hand (or what it holds) keeps above a surface while moving over it
 KEEPOUT_MARGIN = 0.03  # m added to the footprint radius when the base moves during a reach
 DESCEND_SPEED = 0.1  # m/s for the last few centimetres to a grasp or a placement
-# m and rad a grasp's descent ends within: a pad 1.5 cm from the object's side cannot land on its top
-DESCEND_TOLERANCE = (0.008, 0.1)
 RELEASE_GAP = 0.005  # m between a placed object's bottom and the surface when the gripper opens
 GRASP_WIDTH_TOLERANCE = 0.015  # m: a closed width further than this from the object's size is "something else"
 OFF_CENTRE_GRIP = 0.012  # m across the pads from their middle: pressed on the pads' outer fifth alone, held by an edge
@@ -561,7 +560,7 @@ class Grasp(_ManipulationSkill):
             return False
         side = self.params.side
         hand = self._hand_xyz(side)
-        if not self.grasp.closes_from(hand, self._hand_yaw(side), DESCEND_TOLERANCE[1], DESCEND_TOLERANCE[0]):
+        if not self.grasp.closes_from(hand, self._hand_yaw(side)):
             return False
         self.grasp = replace(self.grasp, position=hand)  # where it holds: what the put lowers by
         return True
